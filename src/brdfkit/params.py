@@ -1,0 +1,279 @@
+"""Parameter specifications: the single source of truth for every model parameter.
+
+A model declares its parameters once, as a tuple of :class:`Param`. That tuple
+drives
+
+* validation in ``bk.model(name, **params)`` (:func:`validate`),
+* ``brdfkit info MODEL`` (:func:`Param.as_row`),
+* parsing of ``-p name=value`` on the command line (:func:`parse_value`),
+* the web UI's sliders and the fitting bounds (``range``, ``fit``).
+
+Kinds
+-----
+``scalar``  a finite float within ``range``
+``rgb``     a linear-RGB triple (a scalar means grey), each channel within ``range``
+``choice``  one of ``choices`` (a string)
+``bool``    ``True``/``False``
+``int``     an integer within ``range``
+
+Every error is a one-line :class:`ValueError` naming the model, the parameter
+and what is allowed.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any, Iterable, Mapping, Sequence
+
+import numpy as np
+
+KINDS = ("scalar", "rgb", "choice", "bool", "int")
+
+
+@dataclass(frozen=True)
+class Param:
+    """One parameter of a model.
+
+    ``range`` is ``(lo, hi)`` (inclusive unless ``open_lo``/``open_hi``) for
+    ``scalar``, ``rgb`` and ``int``; ``math.inf`` is allowed as ``hi``.
+    ``fit_range`` optionally narrows the range used as fitting bounds (e.g. a
+    shininess that may go to 1e6 but is fitted within [1, 1e4]).
+    ``fit`` says whether the fitter may vary it (choices and bools never are).
+    """
+
+    name: str
+    kind: str
+    default: Any
+    range: tuple[float, float] | None = None
+    unit: str = ""
+    doc: str = ""
+    choices: tuple[str, ...] = ()
+    open_lo: bool = False
+    open_hi: bool = False
+    fit: bool = True
+    fit_range: tuple[float, float] | None = None
+    log_scale: bool = False  # UI / fitting hint: the parameter spans decades
+
+    def __post_init__(self) -> None:
+        if self.kind not in KINDS:
+            raise TypeError(f"unknown parameter kind {self.kind!r}")
+        if self.kind == "choice" and self.default not in self.choices:
+            raise TypeError(f"default {self.default!r} of {self.name} not among {self.choices}")
+
+    # -- description -----------------------------------------------------
+    def range_text(self) -> str:
+        if self.kind == "choice":
+            return " | ".join(self.choices)
+        if self.kind == "bool":
+            return "true | false"
+        if self.range is None:
+            return "any finite"
+        lo, hi = self.range
+        lb = "(" if self.open_lo else "["
+        rb = ")" if (self.open_hi or math.isinf(hi)) else "]"
+        return f"{lb}{_fmt(lo)}, {_fmt(hi)}{rb}"
+
+    def default_json(self) -> Any:
+        d = self.default
+        if isinstance(d, np.ndarray):
+            return d.tolist()
+        if isinstance(d, tuple):
+            return list(d)
+        return d
+
+    def as_row(self) -> dict[str, Any]:
+        """The row ``model_info`` and ``brdfkit info`` show."""
+        return {
+            "name": self.name,
+            "kind": self.kind,
+            "default": self.default_json(),
+            "range": self.range_text(),
+            "min": None if self.range is None or self.kind in ("choice", "bool") else self.range[0],
+            "max": None
+            if self.range is None or self.kind in ("choice", "bool") or math.isinf(self.range[1])
+            else self.range[1],
+            "choices": list(self.choices) if self.kind == "choice" else None,
+            "unit": self.unit,
+            "doc": self.doc,
+        }
+
+    # -- validation --------------------------------------------------------
+    def _check_number(self, model: str, x: float, what: str) -> None:
+        if not math.isfinite(x):
+            raise ValueError(
+                f"{model}: parameter '{self.name}'{what} must be finite, got {x!r}; allowed {self.range_text()}"
+            )
+        if self.range is not None:
+            lo, hi = self.range
+            bad_lo = x <= lo if self.open_lo else x < lo
+            bad_hi = x >= hi if self.open_hi else x > hi
+            if bad_lo or bad_hi:
+                raise ValueError(
+                    f"{model}: parameter '{self.name}'{what} = {_fmt(x)} is out of range; allowed {self.range_text()}"
+                )
+
+    def validate(self, model: str, value: Any) -> Any:
+        """Return the canonical value (float, (3,) float64 array, str, bool, int)."""
+        k = self.kind
+        if k == "bool":
+            if isinstance(value, (bool, np.bool_)):
+                return bool(value)
+            if isinstance(value, str) and value.lower() in ("true", "false", "1", "0", "yes", "no", "on", "off"):
+                return value.lower() in ("true", "1", "yes", "on")
+            if isinstance(value, (int, np.integer)) and value in (0, 1):
+                return bool(value)
+            raise ValueError(f"{model}: parameter '{self.name}' must be true or false, got {value!r}")
+        if k == "choice":
+            if isinstance(value, str) and value in self.choices:
+                return value
+            raise ValueError(
+                f"{model}: parameter '{self.name}' must be one of {', '.join(self.choices)}; got {value!r}"
+            )
+        if k == "int":
+            try:
+                f = float(value)
+            except (TypeError, ValueError):
+                raise ValueError(f"{model}: parameter '{self.name}' must be an integer, got {value!r}") from None
+            if not math.isfinite(f) or f != int(f):
+                raise ValueError(f"{model}: parameter '{self.name}' must be an integer, got {value!r}")
+            self._check_number(model, f, "")
+            return int(f)
+        if k == "scalar":
+            if isinstance(value, (str, bytes)) or isinstance(value, bool):
+                raise ValueError(f"{model}: parameter '{self.name}' must be a number, got {value!r}")
+            arr = np.asarray(value, dtype=object)
+            if arr.ndim != 0:
+                raise ValueError(f"{model}: parameter '{self.name}' must be a single number, got {value!r}")
+            try:
+                f = float(value)
+            except (TypeError, ValueError):
+                raise ValueError(f"{model}: parameter '{self.name}' must be a number, got {value!r}") from None
+            self._check_number(model, f, "")
+            return f
+        # rgb
+        if isinstance(value, (str, bytes)) or isinstance(value, bool):
+            raise ValueError(f"{model}: parameter '{self.name}' must be a number or an RGB triple, got {value!r}")
+        try:
+            arr = np.asarray(value, dtype=np.float64)
+        except (TypeError, ValueError):
+            raise ValueError(
+                f"{model}: parameter '{self.name}' must be a number or an RGB triple, got {value!r}"
+            ) from None
+        if arr.ndim == 0:
+            arr = np.full(3, float(arr))
+        elif arr.shape != (3,):
+            raise ValueError(
+                f"{model}: parameter '{self.name}' must be a number or an RGB triple, got shape {arr.shape}"
+            )
+        for i, c in enumerate(arr):
+            self._check_number(model, float(c), f"[{'rgb'[i]}]")
+        arr = arr.copy()
+        arr.setflags(write=False)
+        return arr
+
+
+def _fmt(x: float) -> str:
+    if math.isinf(x):
+        return "inf" if x > 0 else "-inf"
+    return f"{x:g}"
+
+
+ParamSpec = Sequence[Param]
+
+
+def spec_names(spec: ParamSpec) -> list[str]:
+    return [p.name for p in spec]
+
+
+def validate(model: str, spec: ParamSpec, given: Mapping[str, Any]) -> dict[str, Any]:
+    """Validate ``given`` against ``spec``; fill defaults; return the effective parameters.
+
+    Raises a one-line ``ValueError`` for an unknown name, a wrong kind, a value
+    out of range or not finite.
+    """
+    by_name = {p.name: p for p in spec}
+    for name in given:
+        if name not in by_name:
+            valid = ", ".join(by_name) or "(none)"
+            raise ValueError(f"{model}: unknown parameter '{name}'; valid parameters: {valid}")
+    out: dict[str, Any] = {}
+    for p in spec:
+        out[p.name] = p.validate(model, given[p.name] if p.name in given else p.default)
+    return out
+
+
+def parse_value(model: str, param: Param, text: str) -> Any:
+    """Parse the text of ``-p name=value`` for ``param`` (numbers, ``r,g,b``, true/false, choices)."""
+    text = text.strip()
+    if param.kind in ("choice", "bool"):
+        return param.validate(model, text)
+    if param.kind == "rgb":
+        parts = [t for t in text.split(",")]
+        try:
+            nums = [float(t) for t in parts]
+        except ValueError:
+            raise ValueError(
+                f"{model}: parameter '{param.name}' expects a number or r,g,b; got {text!r}"
+            ) from None
+        if len(nums) == 1:
+            return param.validate(model, nums[0])
+        if len(nums) != 3:
+            raise ValueError(f"{model}: parameter '{param.name}' expects 1 or 3 numbers, got {len(nums)}")
+        return param.validate(model, nums)
+    try:
+        num = float(text)
+    except ValueError:
+        raise ValueError(f"{model}: parameter '{param.name}' expects a number; got {text!r}") from None
+    return param.validate(model, num)
+
+
+def parse_assignments(model: str, spec: ParamSpec, items: Iterable[str]) -> dict[str, Any]:
+    """Parse repeated ``name=value`` strings into a validated-value dict (not yet defaults-filled)."""
+    by_name = {p.name: p for p in spec}
+    out: dict[str, Any] = {}
+    for item in items:
+        if "=" not in item:
+            raise ValueError(f"{model}: parameter assignment {item!r} must look like name=value")
+        name, _, text = item.partition("=")
+        name = name.strip()
+        if name not in by_name:
+            valid = ", ".join(by_name) or "(none)"
+            raise ValueError(f"{model}: unknown parameter '{name}'; valid parameters: {valid}")
+        out[name] = parse_value(model, by_name[name], text)
+    return out
+
+
+def to_jsonable(params: Mapping[str, Any]) -> dict[str, Any]:
+    """Parameters as plain JSON values (arrays -> lists)."""
+    out = {}
+    for k, v in params.items():
+        if isinstance(v, np.ndarray):
+            out[k] = [float(x) for x in v]
+        elif isinstance(v, (np.floating,)):
+            out[k] = float(v)
+        else:
+            out[k] = v
+    return out
+
+
+# Frequently used parameter definitions (shared so that kd means the same everywhere).
+def kd_param(default: Any = 0.5, doc: str = "diffuse albedo (the diffuse term is kd/π)") -> Param:
+    return Param("kd", "rgb", default, (0.0, 1.0), "", doc)
+
+
+def ks_param(default: Any = 0.5, doc: str = "specular weight", hi: float = 1.0) -> Param:
+    return Param("ks", "rgb", default, (0.0, hi), "", doc)
+
+
+__all__ = [
+    "Param",
+    "ParamSpec",
+    "validate",
+    "parse_value",
+    "parse_assignments",
+    "to_jsonable",
+    "spec_names",
+    "kd_param",
+    "ks_param",
+]
