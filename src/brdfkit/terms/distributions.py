@@ -1,0 +1,248 @@
+"""Microfacet normal distributions D(h) and their Smith Λ functions.
+
+Everything here works in the local shading frame (normal ``+z``, tangent ``+x``,
+SPEC.md). Vector arguments (``h``, ``w``) have shape ``(..., 3)`` and need not be
+exactly unit length only where stated; roughness arguments are scalars or arrays
+that broadcast against ``h[..., 0]``. Results have shape ``h.shape[:-1]`` and the
+dtype of the inputs (float32 stays float32). Roughness must be > 0.
+
+Distributions
+-------------
+* :func:`beckmann_cook` — the Beckmann distribution exactly as Cook & Torrance
+  (1982, eq. 4) and the lecture write it, **without** a 1/π::
+
+      D = exp(−(tan α / m)²) / (m² cos⁴ α)
+
+  (α the angle between n and h, m the RMS slope). It integrates to
+  ``∫ D (n·h) dω_h = π``; the Cook-Torrance formula's ``F/π`` supplies the 1/π.
+
+* :func:`beckmann` — the normalised Beckmann distribution (Walter et al. 2007,
+  eq. 25; anisotropic form e.g. Heitz 2014, eq. 71)::
+
+      D(h) = exp(−(h_x²/α_x² + h_y²/α_y²)/h_z²) / (π α_x α_y h_z⁴)
+
+  with ``∫ D(h) (n·h) dω_h = 1``. ``normalized=False`` drops the 1/π (for
+  α_x = α_y = m this is :func:`beckmann_cook`).
+
+* :func:`ggx` — GGX / Trowbridge-Reitz (Trowbridge & Reitz 1975; Walter et al.
+  2007, eq. 33; anisotropic form Heitz 2014, eq. 85)::
+
+      D(h) = 1 / (π α_x α_y (h_x²/α_x² + h_y²/α_y² + h_z²)²)
+
+Smith Λ (Heitz 2014, "Understanding the masking-shadowing function in
+microfacet-based BRDFs", §5.1-5.2; Walter et al. 2007, eqs. 27, 34)
+----------------------------------------------------------------------
+With the projected roughness of a direction ``w`` (θ its polar angle, φ its
+azimuth) ``α(w)² = α_x² cos²φ + α_y² sin²φ``, so that
+``α(w) tan θ = sqrt(w_x² α_x² + w_y² α_y²) / w_z``:
+
+* Beckmann, exact: ``a = 1/(α(w) tan θ)``,
+  ``Λ = (erf(a) − 1)/2 + exp(−a²)/(2 a √π)``
+* GGX, exact: ``Λ = (−1 + sqrt(1 + α(w)² tan² θ))/2``
+
+``Λ = 0`` at normal incidence (tan θ = 0) and ``Λ → ∞`` at the horizon, where
+the Smith masking ``G1 = 1/(1 + Λ)`` (see :mod:`brdfkit.terms.shadowing`) goes
+to 0. Both are evaluated in forms that do not cancel catastrophically and
+never produce NaN: Beckmann via ``erfc``, GGX as
+``s² / (2 w_z (sqrt(w_z² + s²) + w_z))`` with ``s = sqrt(w_x² α_x² + w_y² α_y²)``.
+
+Numerics of D
+-------------
+The exponent ``tan²θ/α²`` can be huge (small α, grazing h) while ``cos⁴θ``
+underflows; D is evaluated as ``exp(−e − 4 ln h_z)`` so that it underflows to 0
+instead of becoming ``0/0`` or ``inf/inf``, in float32 as in float64. For
+``h_z <= 0`` every D here returns 0.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.special import erfc
+
+_SQRT_PI = np.sqrt(np.pi)
+
+
+def _dtype_of(x):
+    """Working dtype: float32 for float32 input, float64 otherwise (roughness follows)."""
+    x = np.asarray(x)
+    return np.dtype(np.float32) if x.dtype == np.float32 else np.dtype(np.float64)
+
+
+def _split(h, alpha_x, alpha_y):
+    h = np.asarray(h)
+    dt = _dtype_of(h)
+    h = h.astype(dt, copy=False)
+    ax = np.asarray(alpha_x, dtype=dt)
+    ay = ax if alpha_y is None else np.asarray(alpha_y, dtype=dt)
+    return h[..., 0], h[..., 1], h[..., 2], ax, ay, dt
+
+
+def _slope2(hx, hy, ax, ay):
+    """``h_x²/α_x² + h_y²/α_y²`` (= tan²θ_h/α(h)² · h_z²)."""
+    return (hx / ax) ** 2 + (hy / ay) ** 2
+
+
+# --------------------------------------------------------------------------- D
+
+
+def beckmann(h, alpha_x, alpha_y=None, normalized=True):
+    """Beckmann distribution D(h) of local half vectors ``h`` (unit, ``(..., 3)``).
+
+    ``D = exp(−(h_x²/α_x² + h_y²/α_y²)/h_z²) / (π α_x α_y h_z⁴)`` (Beckmann &
+    Spizzichino 1963; Walter et al. 2007, eq. 25; anisotropic: Heitz 2014, eq. 71).
+    ``alpha_y=None`` means isotropic (α_y = α_x); α is the RMS slope, α_x along
+    the tangent +x. ``normalized=False`` omits the 1/π, which gives the
+    Cook-Torrance (1982) / lecture form (see :func:`beckmann_cook`).
+    Returns 0 for ``h_z <= 0``; underflows to 0 (never NaN/Inf) for tiny ``h_z``.
+    """
+    hx, hy, hz, ax, ay, dt = _split(h, alpha_x, alpha_y)
+    up = hz > 0
+    hz_s = np.where(up, hz, dt.type(1))
+    with np.errstate(over="ignore", divide="ignore", under="ignore", invalid="ignore"):
+        e = _slope2(hx, hy, ax, ay) / (hz_s * hz_s)
+        d = np.exp(-e - dt.type(4) * np.log(hz_s)) / (ax * ay)
+    if normalized:
+        d = d / dt.type(np.pi)
+    return np.where(up, d, dt.type(0))
+
+
+def beckmann_cook(cos_h, m):
+    """The lecture's / Cook & Torrance's (1982, eq. 4) Beckmann D from ``cos α = n·h``.
+
+    ``D = exp(−(tan α/m)²) / (m² cos⁴ α)`` — no 1/π; ``∫ D cos α dω = π``.
+    ``tan² α`` is formed as ``(1 − cos²α)/cos²α`` (for half vectors prefer
+    ``beckmann(h, m, normalized=False)``, which uses ``h_x, h_y`` and is more
+    accurate near the peak in float32). Returns 0 for ``cos α <= 0``.
+    """
+    c = np.asarray(cos_h)
+    dt = _dtype_of(c)
+    c = np.clip(c.astype(dt, copy=False), dt.type(-1), dt.type(1))
+    m = np.asarray(m, dtype=dt)
+    up = c > 0
+    cs = np.where(up, c, dt.type(1))
+    with np.errstate(over="ignore", divide="ignore", under="ignore", invalid="ignore"):
+        t2 = (dt.type(1) - cs * cs) / (cs * cs)
+        d = np.exp(-t2 / (m * m) - dt.type(4) * np.log(cs)) / (m * m)
+    return np.where(up, d, dt.type(0))
+
+
+def ggx(h, alpha_x, alpha_y=None):
+    """GGX / Trowbridge-Reitz distribution D(h) of local half vectors ``h``.
+
+    ``D = 1 / (π α_x α_y (h_x²/α_x² + h_y²/α_y² + h_z²)²)`` (Trowbridge & Reitz
+    1975; Walter et al. 2007, eq. 33; anisotropic: Heitz 2014, eq. 85).
+    ``alpha_y=None`` means isotropic. Returns 0 for ``h_z <= 0``.
+    """
+    hx, hy, hz, ax, ay, dt = _split(h, alpha_x, alpha_y)
+    with np.errstate(over="ignore", under="ignore"):
+        q = _slope2(hx, hy, ax, ay) + hz * hz
+        d = dt.type(1) / (dt.type(np.pi) * ax * ay * q * q)
+    return np.where(hz > 0, d, dt.type(0))
+
+
+def _cos_to_h(cos_h):
+    c = np.asarray(cos_h)
+    dt = _dtype_of(c)
+    c = np.clip(c.astype(dt, copy=False), dt.type(-1), dt.type(1))
+    s = np.sqrt(np.maximum(dt.type(0), dt.type(1) - c * c))
+    return np.stack([s, np.zeros_like(s), c], axis=-1)
+
+
+def beckmann_iso(cos_h, alpha):
+    """Normalised isotropic Beckmann D from ``cos θ_h``: ``exp(−tan²θ/α²)/(π α² cos⁴θ)``."""
+    return beckmann(_cos_to_h(cos_h), alpha)
+
+
+def ggx_iso(cos_h, alpha):
+    """Isotropic GGX D from ``cos θ_h``: ``α² / (π cos⁴θ (α² + tan²θ)²)``."""
+    return ggx(_cos_to_h(cos_h), alpha)
+
+
+# ---------------------------------------------------------------------- Smith Λ
+
+
+def projected_roughness_tan(w, alpha_x, alpha_y=None):
+    """``(s, w_z)`` with ``s = sqrt(w_x² α_x² + w_y² α_y²)``, so ``α(w) tan θ = s / w_z``.
+
+    ``α(w) = sqrt(α_x² cos²φ + α_y² sin²φ)`` is the roughness of the 1-D slope
+    distribution seen along the azimuth of ``w`` (Heitz 2014, eq. 80).
+    """
+    wx, wy, wz, ax, ay, dt = _split(w, alpha_x, alpha_y)
+    return np.sqrt((wx * ax) ** 2 + (wy * ay) ** 2), wz
+
+
+def beckmann_lambda(w, alpha_x, alpha_y=None):
+    """Exact Smith Λ of the Beckmann distribution for local directions ``w`` (unit).
+
+    ``a = 1/(α(w) tan θ) = w_z / sqrt(w_x² α_x² + w_y² α_y²)``,
+    ``Λ = (erf(a) − 1)/2 + exp(−a²)/(2 a √π) = (exp(−a²)/(a √π) − erfc(a))/2``
+    (Walter et al. 2007, eq. 27 with G1 = 1/(1+Λ); Heitz 2014, eq. 72).
+    Λ = 0 at normal incidence, +inf for ``w_z <= 0`` (G1 = 0 there); never NaN.
+    """
+    s, wz = projected_roughness_tan(w, alpha_x, alpha_y)
+    dt = s.dtype
+    up = wz > 0
+    with np.errstate(over="ignore", divide="ignore", under="ignore", invalid="ignore"):
+        a = np.where(up, wz, dt.type(1)) / s  # s == 0 -> a = inf -> Λ = 0
+        lam = dt.type(0.5) * (np.exp(-a * a) / (a * dt.type(_SQRT_PI)) - erfc(a).astype(dt, copy=False))
+    lam = np.where(np.isnan(lam), dt.type(0), lam)  # a = inf gives 0/inf - 0 = 0 already; belt and braces
+    lam = np.maximum(lam, dt.type(0))
+    return np.where(up, lam, dt.type(np.inf))
+
+
+def ggx_lambda(w, alpha_x, alpha_y=None):
+    """Exact Smith Λ of the GGX distribution for local directions ``w`` (unit).
+
+    ``Λ = (−1 + sqrt(1 + α(w)² tan²θ))/2``, evaluated as
+    ``s² / (2 w_z (sqrt(w_z² + s²) + w_z))`` with ``s = α(w) tan θ · w_z``
+    (Walter et al. 2007, eq. 34; Heitz 2014, eq. 86). Λ = 0 at normal incidence,
+    +inf for ``w_z <= 0``; never NaN.
+    """
+    s, wz = projected_roughness_tan(w, alpha_x, alpha_y)
+    dt = s.dtype
+    up = wz > 0
+    wz_s = np.where(up, wz, dt.type(1))
+    with np.errstate(over="ignore", divide="ignore", under="ignore", invalid="ignore"):
+        lam = (s * s) / (dt.type(2) * wz_s * (np.sqrt(wz_s * wz_s + s * s) + wz_s))
+    return np.where(up, lam, dt.type(np.inf))
+
+
+def beckmann_lambda_iso(cos_t, alpha):
+    """Isotropic Beckmann Λ from ``cos θ`` (see :func:`beckmann_lambda`)."""
+    return beckmann_lambda(_cos_to_h(cos_t), alpha)
+
+
+def ggx_lambda_iso(cos_t, alpha):
+    """Isotropic GGX Λ from ``cos θ`` (see :func:`ggx_lambda`)."""
+    return ggx_lambda(_cos_to_h(cos_t), alpha)
+
+
+#: name -> (D(h, alpha_x, alpha_y=None), Λ(w, alpha_x, alpha_y=None)), normalised D.
+DISTRIBUTIONS = {
+    "beckmann": (beckmann, beckmann_lambda),
+    "ggx": (ggx, ggx_lambda),
+}
+
+
+def distribution(name):
+    """``(D, Lambda)`` functions for ``"beckmann"`` or ``"ggx"``; ValueError otherwise."""
+    try:
+        return DISTRIBUTIONS[name]
+    except (KeyError, TypeError):
+        raise ValueError(f"unknown microfacet distribution {name!r}; valid: {', '.join(DISTRIBUTIONS)}") from None
+
+
+__all__ = [
+    "beckmann",
+    "beckmann_cook",
+    "beckmann_iso",
+    "ggx",
+    "ggx_iso",
+    "projected_roughness_tan",
+    "beckmann_lambda",
+    "ggx_lambda",
+    "beckmann_lambda_iso",
+    "ggx_lambda_iso",
+    "DISTRIBUTIONS",
+    "distribution",
+]
