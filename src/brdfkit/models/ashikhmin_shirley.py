@@ -1,0 +1,127 @@
+"""Ashikhmin-Shirley: an anisotropic Phong BRDF with a coupled diffuse term.
+
+Reference: M. Ashikhmin and P. Shirley, "An Anisotropic Phong BRDF Model",
+Journal of Graphics Tools 5(2), 2000, 25-32 (eqs. 4 and 5).
+
+With k = wi (or wo: h·wi = h·wo), h = normalize(wi + wo) with azimuth φh from
+the tangent +x, n = +z:
+
+    f_r = ρ_s + ρ_d
+
+    ρ_s = sqrt((nu+1)(nv+1))/(8π) · (n·h)^(nu cos²φh + nv sin²φh)
+          / ((h·k) · max(n·wi, n·wo)) · F(h·k)
+    F(c) = Rs + (1 − Rs)(1 − c)⁵                         (Schlick's Fresnel)
+
+    ρ_d = 28 Rd / (23π) · (1 − Rs) · (1 − (1 − n·wi/2)⁵) · (1 − (1 − n·wo/2)⁵)
+
+``nu`` is the exponent along the tangent +x, ``nv`` along +y: with nu < nv the
+highlight is wider in x. The exponent is evaluated as
+(nu hx² + nv hy²)/(hx² + hy²) (= nu cos²φh + nv sin²φh), and the power as
+
+    (n·h)^e = exp(½ · (nu hx² + nv hy²) · log(1 − s²)/s²),   s² = hx² + hy²
+
+(log(1 − s²)/s² → −1 as s² → 0), so h = n gives exactly 1 instead of 0/0, and
+large exponents underflow to 0 instead of overflowing.
+
+Both terms are symmetric in wi and wo: the model is reciprocal. The paper
+designs it to conserve energy (the diffuse term is scaled by (1 − Rs) and its
+constant 28/23 normalises it); the specular lobe's albedo approaches but does
+not in general equal F, so energy conservation holds only approximately —
+`brdfkit check` measures it.
+
+Numerics: h·k and max(n·wi, n·wo) are clamped to a floor of 1e-6 in the
+denominator (they vanish only when both directions are within 0.00006° of
+the horizon), which keeps every value finite.
+
+=========  ======  =======  ============  =============================================
+parameter  kind    default  range         meaning
+=========  ======  =======  ============  =============================================
+rd         rgb     0.5      [0, 1]        diffuse reflectance R_d
+rs         rgb     0.05     [0, 1]        specular reflectance at normal incidence R_s
+nu         scalar  100      [0, 1e5]      Phong exponent along the tangent +x
+nv         scalar  100      [0, 1e5]      Phong exponent along the bitangent +y
+=========  ======  =======  ============  =============================================
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..params import Param
+from ..registry import register
+from ..terms.fresnel import fresnel_schlick
+from .base import BRDF
+
+#: floor on h·k and max(n·wi, n·wo) in the specular denominator
+COS_FLOOR = 1e-6
+
+
+def _scaled_half(wi, wo):
+    """``(hx, hy, hz, |H|)`` of H = wi + wo rescaled by its largest component (safe for z = 1e-300)."""
+    H = wi + wo
+    m = np.max(np.abs(H), axis=-1)
+    Hs = H / m[..., None]
+    ln = np.sqrt(np.einsum("...i,...i->...", Hs, Hs))
+    return Hs[..., 0] / ln, Hs[..., 1] / ln, Hs[..., 2] / ln, m * ln
+
+
+def anisotropic_cos_power(hx, hy, hz, nu, nv):
+    """``(n·h)^((nu hx² + nv hy²)/(hx² + hy²))`` for a unit h, stable at h = n and for huge exponents."""
+    s2 = hx * hx + hy * hy
+    t = nu * hx * hx + nv * hy * hy
+    one = np.ones_like(s2)
+    # log(1 - s²)/s²: log1p where s² is small (no cancellation), 2 log(hz) otherwise
+    small = s2 < 0.5
+    lg = np.where(small, np.log1p(-np.where(small, s2, 0)), 2 * np.log(np.where(small, one, hz)))
+    q = np.where(s2 > 0, lg / np.where(s2 > 0, s2, 1), -1)
+    return np.where(t > 0, np.exp(0.5 * q * t), 1)
+
+
+@register
+class AshikhminShirley(BRDF):
+    name = "ashikhmin-shirley"
+    title = "Ashikhmin-Shirley anisotropic Phong with coupled diffuse term and Schlick Fresnel"
+    reference = "Ashikhmin and Shirley, An Anisotropic Phong BRDF Model, JGT 5(2), 2000"
+    isotropic = False
+    spec = (
+        Param("rd", "rgb", 0.5, (0.0, 1.0), "", "diffuse reflectance R_d"),
+        Param("rs", "rgb", 0.05, (0.0, 1.0), "", "specular reflectance at normal incidence R_s (Schlick F0)"),
+        Param(
+            "nu",
+            "scalar",
+            100.0,
+            (0.0, 1e5),
+            "",
+            "Phong exponent along the tangent +x (smaller = wider highlight in x)",
+            fit_range=(1.0, 1e4),
+            log_scale=True,
+        ),
+        Param(
+            "nv",
+            "scalar",
+            100.0,
+            (0.0, 1e5),
+            "",
+            "Phong exponent along the bitangent +y",
+            fit_range=(1.0, 1e4),
+            log_scale=True,
+        ),
+    )
+
+    def _eval(self, wi, wo, p):
+        dt = wi.dtype.type
+        pi = dt(np.pi)
+        rd, rs = p["rd"], p["rs"]
+        nu, nv = p["nu"], p["nv"]
+        hx, hy, hz, _ = _scaled_half(wi, wo)
+        hk = np.clip(np.einsum("...i,...i->...", wi, np.stack([hx, hy, hz], axis=-1)), dt(0), dt(1))
+        ci, co = wi[..., 2], wo[..., 2]
+        lobe = anisotropic_cos_power(hx, hy, hz, nu, nv)
+        floor = dt(COS_FLOOR)
+        denom = np.maximum(hk, floor) * np.maximum(np.maximum(ci, co), floor)
+        k = np.sqrt((nu + dt(1)) * (nv + dt(1))) / (dt(8) * pi)
+        spec = (k * lobe / denom)[..., None] * fresnel_schlick(rs, hk[..., None])
+        a = dt(1) - (dt(1) - ci * dt(0.5)) ** 5
+        b = dt(1) - (dt(1) - co * dt(0.5)) ** 5
+        diff = (dt(28) / (dt(23) * pi)) * rd * (dt(1) - rs) * (a * b)[..., None]
+        return diff + spec

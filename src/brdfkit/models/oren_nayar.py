@@ -1,0 +1,147 @@
+"""Oren-Nayar: rough diffuse reflection from V-cavities of Lambertian facets.
+
+Reference: M. Oren and S. K. Nayar, "Generalization of Lambert's Reflectance
+Model", SIGGRAPH 1994, pp. 239-246 — the functional approximation of the
+single-scattering radiance L_r^1 (coefficients C1, C2, C3), the
+interreflection component L_r^2, and the "qualitative model" with A and B.
+(The equations are quoted below; their numbers in the paper were not
+checked against the PDF, which was not available to us.)
+
+Angles: θi, θo polar angles of wi and wo, Δφ = φo − φi, α = max(θi, θo),
+β = min(θi, θo), σ the standard deviation of the facet slope angle (radians),
+ρ = kd the facet albedo. The paper writes radiances for a source of
+irradiance E0 at normal incidence, L = (…)·E0 cos θi; the BRDF is the bracket
+without E0 cos θi.
+
+variant="qualitative" (the lecture's formula):
+
+    f_r = (ρ/π) (A + B · max(0, cos Δφ) · sin α · tan β)
+    A = 1 − 0.5 σ²/(σ² + 0.33),   B = 0.45 σ²/(σ² + 0.09)
+
+variant="full" (the paper's model with interreflections):
+
+    f_r = f1 + f2
+    f1 = (ρ/π) [C1 + cos Δφ · C2 · tan β + (1 − |cos Δφ|) · C3 · tan((α+β)/2)]
+    f2 = 0.17 (ρ²/π) σ²/(σ² + 0.13) · [1 − cos Δφ · (2β/π)²]
+    C1 = 1 − 0.5 σ²/(σ² + 0.33)
+    C2 = 0.45 σ²/(σ² + 0.09) · sin α                    if cos Δφ ≥ 0
+         0.45 σ²/(σ² + 0.09) · (sin α − (2β/π)³)        otherwise
+    C3 = 0.125 σ²/(σ² + 0.09) · (4αβ/π²)²
+
+σ = 0 gives A = C1 = 1 and B = C2 = C3 = f2 = 0: exactly Lambert, kd/π.
+
+Both variants are symmetric in (wi, wo) (α, β and |Δφ| are), hence
+reciprocal. Neither is exactly energy conserving: they are fits to a
+V-cavity model, and tan β grows without bound when both directions approach
+the horizon. Measured directional albedo with kd = 1: qualitative σ = 0.1
+reaches 1.008 at θi = 89.9° (σ = 0.3: 1.005; σ = 0.5: ≤ 0.95); full σ = 0.3
+reaches 1.05 (σ = 0.1: 1.015; σ = 0.5: 1.025) — a few percent over 1 near
+grazing incidence, below 1 elsewhere. The full variant's f2 is quadratic in ρ, so its RGB response is
+not proportional to kd.
+
+The full model's fit can go *negative*: for cos Δφ < 0 the C2 term is
+subtracted and grows like tan β, e.g. σ = 1.5, θ = 80° and 89°, Δφ = π gives
+C1 + cos Δφ·C2·tan β ≈ 0.56 − 0.73 < 0. We clamp the bracket of f1 at 0
+(a radiance cannot be negative); values where it is positive are untouched.
+
+Numerics: the polar angles come from ``arctan2(sin θ, cos θ)`` (accurate near
+the normal); cos Δφ is computed from the normalised projections onto the
+tangent plane and taken as 0 when either direction is the normal (φ is then
+undefined, and every term that multiplies cos Δφ vanishes there anyway because
+β = 0). tan β = sin β / cos β and tan((α+β)/2) = (sin α + sin β)/(cos α + cos β)
+use a floor of 1e-6 on cos β and on cos α + cos β, which only alters values
+when both directions are within 0.00006° of the horizon; this keeps every
+value finite (the exact model diverges there).
+
+=========  ======  ===========  =====================  ==================================
+parameter  kind    default      range                  meaning
+=========  ======  ===========  =====================  ==================================
+kd         rgb     0.8          [0, 1]                 facet albedo ρ (σ = 0: kd/π)
+sigma      scalar  0.3          [0, π/2)  rad          std. dev. of the facet slope angle
+variant    choice  qualitative  qualitative | full     the A,B model or the full model
+=========  ======  ===========  =====================  ==================================
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..params import Param, kd_param
+from ..registry import register
+from .base import BRDF
+
+#: floor on cos β and on cos α + cos β (keeps tan β and tan((α+β)/2) finite)
+COS_FLOOR = 1e-6
+
+
+def _angles(w):
+    """sin θ, cos θ, θ and the unit azimuth vector (cos φ, sin φ) (zeros at the normal)."""
+    x, y, z = w[..., 0], w[..., 1], w[..., 2]
+    s = np.hypot(x, y)
+    theta = np.arctan2(s, z)
+    safe = s > 0
+    d = np.where(safe, s, 1)
+    cphi = np.where(safe, x / d, 0)
+    sphi = np.where(safe, y / d, 0)
+    return s, z, theta, cphi, sphi
+
+
+@register
+class OrenNayar(BRDF):
+    name = "oren-nayar"
+    title = "Oren-Nayar rough diffuse (qualitative A,B model or the full 1994 model)"
+    reference = "Oren and Nayar, Generalization of Lambert's Reflectance Model, SIGGRAPH 1994"
+    isotropic = True
+    spec = (
+        kd_param(0.8, "facet albedo ρ (σ = 0 gives Lambert kd/π)"),
+        Param(
+            "sigma",
+            "scalar",
+            0.3,
+            (0.0, float(np.pi / 2)),
+            "rad",
+            "standard deviation σ of the facet slope angle (0 = Lambert)",
+            open_hi=True,
+        ),
+        Param(
+            "variant",
+            "choice",
+            "qualitative",
+            doc="qualitative: the lecture's A, B formula; full: C1, C2, C3 and the interreflection term",
+            choices=("qualitative", "full"),
+            fit=False,
+        ),
+    )
+
+    def _eval(self, wi, wo, p):
+        dt = wi.dtype.type
+        pi = dt(np.pi)
+        kd = p["kd"]
+        sig2 = p["sigma"] * p["sigma"]
+        si, ci, ti, cpi, spi = _angles(wi)
+        so, co, to, cpo, spo = _angles(wo)
+        cos_dphi = np.clip(cpi * cpo + spi * spo, dt(-1), dt(1))
+        sin_a = np.maximum(si, so)  # α = max(θi, θo): the larger sine, the smaller cosine
+        cos_a = np.minimum(ci, co)
+        sin_b = np.minimum(si, so)
+        cos_b = np.maximum(ci, co)
+        tan_b = sin_b / np.maximum(cos_b, dt(COS_FLOOR))
+
+        if p["variant"] == "qualitative":
+            A = dt(1) - dt(0.5) * sig2 / (sig2 + dt(0.33))
+            B = dt(0.45) * sig2 / (sig2 + dt(0.09))
+            g = A + B * np.maximum(cos_dphi, dt(0)) * sin_a * tan_b
+            return (kd / pi) * g[..., None]
+
+        alpha = np.maximum(ti, to)
+        beta = np.minimum(ti, to)
+        two_b_pi = dt(2) * beta / pi
+        C1 = dt(1) - dt(0.5) * sig2 / (sig2 + dt(0.33))
+        k2 = dt(0.45) * sig2 / (sig2 + dt(0.09))
+        C2 = np.where(cos_dphi >= 0, k2 * sin_a, k2 * (sin_a - two_b_pi**3))
+        C3 = dt(0.125) * sig2 / (sig2 + dt(0.09)) * (dt(4) * alpha * beta / (pi * pi)) ** 2
+        tan_half = (sin_a + sin_b) / np.maximum(cos_a + cos_b, dt(COS_FLOOR))
+        g1 = C1 + cos_dphi * C2 * tan_b + (dt(1) - np.abs(cos_dphi)) * C3 * tan_half
+        g1 = np.maximum(g1, dt(0))  # the fit dips below 0 for large σ, grazing, Δφ ≈ π
+        g2 = dt(0.17) * sig2 / (sig2 + dt(0.13)) * (dt(1) - cos_dphi * two_b_pi**2)
+        return (kd / pi) * g1[..., None] + (kd * kd / pi) * g2[..., None]

@@ -1,0 +1,110 @@
+"""Phong: a diffuse term plus a cosine-power lobe around the mirror direction.
+
+References:
+  B. T. Phong, "Illumination for computer generated pictures",
+  Communications of the ACM 18(6), 1975 (the lighting-equation term).
+  R. R. Lewis, "Making shaders more physically plausible",
+  Computer Graphics Forum 13(2), 1994 (the normalised, reciprocal BRDF).
+
+With ``r = reflect(wi) = 2 (n·wi) n − wi`` (the mirror direction of the light,
+n = +z) and ``x = max(0, r·wo)``:
+
+    f_r = kd/π + ks · lobe
+
+    normalized=True  (Lewis 1994):  lobe = (s + 2)/(2π) · x^s
+    normalized=False (Phong 1975):  lobe = x^s / max(n·wi, 1e-4)
+
+**Normalized.** The factor (s+2)/(2π) makes the lobe's directional albedo
+exactly 1 at normal incidence: ∫ (s+2)/(2π) (r·wo)^s cos θo dωo = 1 for
+wi = n, and smaller at every other incidence (part of the lobe falls below
+the horizon), so the model is energy conserving whenever kd + ks ≤ 1 per
+channel. It is symmetric in wi and wo (r·wo = reflect(wo)·wi), hence
+reciprocal.
+
+**Unnormalized.** Phong's illumination model adds ``ks (r·v)^s I`` to the
+reflected radiance for a light of intensity I; that light delivers the
+irradiance I cos θi, so read as a BRDF (radiance = f_r I cos θi) the term is
+``ks (r·v)^s / cos θi``. It is neither
+reciprocal (the 1/cos θi is not symmetric) nor energy conserving (the
+albedo grows without bound toward grazing light). The 1/cos θi diverges
+at grazing light; to keep every value finite as the contract requires,
+cos θi is clamped to a floor of 1e-4 (θi ≈ 89.994°): f_r·cos θi then equals
+the lighting-equation term exactly for every light above that angle.
+
+At s = 0 the lobe is the step "1 where r·wo > 0" (``max(0, x)^0`` is taken as
+0 where x ≤ 0). Large s is evaluated without overflow; x^s simply
+underflows to 0 away from the mirror direction.
+
+==========  ======  =======  ============  ==========================================
+parameter   kind    default  range         meaning
+==========  ======  =======  ============  ==========================================
+kd          rgb     0.5      [0, 1]        diffuse albedo (kd/π)
+ks          rgb     0.3      [0, 1]        specular weight (normalized: lobe albedo
+                                           at normal incidence)
+shininess   scalar  32       [0, 1e5]      Phong exponent s (fitted within [1, 1e4])
+normalized  bool    true     true | false  Lewis's (s+2)/(2π) form, else the raw
+                                           lighting-equation term / cos θi
+==========  ======  =======  ============  ==========================================
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..params import Param, kd_param, ks_param
+from ..registry import register
+from .base import BRDF
+
+#: floor on cos θi in the unnormalized forms (keeps 1/(n·l) finite at grazing light)
+NL_FLOOR = 1e-4
+
+
+def _cos_power(x, s):
+    """``max(0, x)^s`` with 0 (not 1) where ``x <= 0``, also for ``s = 0``."""
+    pos = x > 0
+    return np.where(pos, np.power(np.where(pos, x, 1), s), 0)
+
+
+@register
+class Phong(BRDF):
+    name = "phong"
+    title = "Phong: kd/π + ks·cosine-power lobe around the mirror direction (Lewis-normalised or raw)"
+    reference = (
+        "Phong, Illumination for computer generated pictures, CACM 18(6), 1975; "
+        "Lewis, Making shaders more physically plausible, CGF 13(2), 1994"
+    )
+    isotropic = True
+    spec = (
+        kd_param(0.5),
+        ks_param(0.3, "specular weight (normalized: the lobe's albedo at normal incidence)"),
+        Param(
+            "shininess",
+            "scalar",
+            32.0,
+            (0.0, 1e5),
+            "",
+            "Phong exponent s of (r·wo)^s",
+            fit_range=(1.0, 1e4),
+            log_scale=True,
+        ),
+        Param(
+            "normalized",
+            "bool",
+            True,
+            doc="true: Lewis 1994 (s+2)/(2π) lobe (reciprocal, energy conserving); "
+            "false: the lighting-equation term divided by cos θi (neither)",
+            fit=False,
+        ),
+    )
+
+    def _eval(self, wi, wo, p):
+        dt = wi.dtype.type
+        # r = reflect(wi) about +z; r·wo
+        rv = wi[..., 2] * wo[..., 2] - wi[..., 0] * wo[..., 0] - wi[..., 1] * wo[..., 1]
+        s = p["shininess"]
+        lobe = _cos_power(np.minimum(rv, dt(1)), s)
+        if p["normalized"]:
+            lobe = lobe * ((s + dt(2)) / dt(2 * np.pi))
+        else:
+            lobe = lobe / np.maximum(wi[..., 2], dt(NL_FLOOR))
+        return p["kd"] / dt(np.pi) + p["ks"] * lobe[..., None]

@@ -1,0 +1,51 @@
+"""Shared helpers for the tests of the classic (non-microfacet) models (test_model_*.py)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+
+def vec(theta_deg: float, phi_deg: float) -> np.ndarray:
+    """Unit vector from polar/azimuth angles in degrees, by plain trigonometry."""
+    t, p = math.radians(theta_deg), math.radians(phi_deg)
+    return np.array([math.sin(t) * math.cos(p), math.sin(t) * math.sin(p), math.cos(t)])
+
+
+def rotate_z(v: np.ndarray, deg: float) -> np.ndarray:
+    c, s = math.cos(math.radians(deg)), math.sin(math.radians(deg))
+    v = np.asarray(v, dtype=np.float64)
+    return np.stack([c * v[..., 0] - s * v[..., 1], s * v[..., 0] + c * v[..., 1], v[..., 2]], axis=-1)
+
+
+def random_upper(n: int, seed: int) -> np.ndarray:
+    """``n`` random unit vectors strictly above the horizon."""
+    rng = np.random.default_rng(seed)
+    v = rng.normal(size=(n, 3))
+    v[:, 2] = np.abs(v[:, 2]) + 1e-3
+    return v / np.linalg.norm(v, axis=1, keepdims=True)
+
+
+def hemisphere_grid(n_mu: int = 400, n_phi: int = 800):
+    """Quadrature over the upper hemisphere: directions ``(N, 3)`` and weights for ∫ g cos θ dω.
+
+    Gauss-Legendre in μ = cos θ on (0, 1) and the periodic trapezoid rule in φ;
+    the weights include the cosine, so ``sum(w * f)`` is the directional albedo of f.
+    """
+    x, wx = np.polynomial.legendre.leggauss(n_mu)
+    mu = 0.5 * (x + 1.0)
+    wmu = 0.5 * wx
+    phi = (np.arange(n_phi) + 0.5) * (2 * np.pi / n_phi)
+    MU, PHI = np.meshgrid(mu, phi, indexing="ij")
+    S = np.sqrt(1 - MU * MU)
+    dirs = np.stack([S * np.cos(PHI), S * np.sin(PHI), MU], axis=-1).reshape(-1, 3)
+    w = (wmu[:, None] * MU * (2 * np.pi / n_phi)).reshape(-1)
+    return dirs, w
+
+
+def albedo(model, wi: np.ndarray, n_mu: int = 400, n_phi: int = 800) -> np.ndarray:
+    """Directional albedo ∫ f(wi, wo) cos θo dωo (RGB) by quadrature."""
+    dirs, w = hemisphere_grid(n_mu, n_phi)
+    f = model.eval(np.asarray(wi, dtype=np.float64)[None, :], dirs)
+    return (w[:, None] * f).sum(axis=0)
