@@ -12,7 +12,7 @@ from _classic_helpers import albedo, random_upper, rotate_z, vec
 
 
 def _by_hand(wi, wo, rd, rs, nu, nv):
-    """Ashikhmin & Shirley 2000, eqs. 4-5, for one pair and one channel, in spherical angles of h."""
+    """Ashikhmin & Shirley 2000, ρ_s + ρ_d, for one pair and one channel, in spherical angles of h."""
     h = [wi[k] + wo[k] for k in range(3)]
     ln = math.sqrt(sum(c * c for c in h))
     h = [c / ln for c in h]
@@ -109,3 +109,30 @@ def test_special_directions_are_finite_and_non_negative(dtype):
         assert f.dtype == dtype
         assert np.all(np.isfinite(f)) and np.all(f >= 0)
         assert np.all(f[:, -1] == 0) and np.all(f[-1, :] == 0)
+
+
+# --- formula audit: ρ_s and ρ_d pinned at hand-worked points -----------------------------------
+# Checked against pbrt-v3's FresnelBlend::f and the CS 184 slides; see the module docstring.
+
+
+def test_audit_half_vector_on_the_normal_with_round_numbers():
+    # wi = (60°, 0°), wo = (60°, 180°): h = n, h·k = 1/2, max(n·k1, n·k2) = 1/2;
+    # nu = 3, nv = 15: sqrt(4·16)/(8π) = 1/π, so ρ_s = (1/π)/(1/4)·F(1/2) = 4/π·(Rs + (1 − Rs)/32);
+    # ρ_d = 28 Rd/(23π)(1 − Rs)(1 − (3/4)⁵)², 1 − (3/4)⁵ = 781/1024
+    rd, rs = 0.5, 0.2
+    m = bk.model("ashikhmin-shirley", rd=rd, rs=rs, nu=3, nv=15)
+    spec = 4 / math.pi * (rs + (1 - rs) / 32)
+    diff = 28 * rd / (23 * math.pi) * (1 - rs) * (781 / 1024) ** 2
+    assert math.isclose(m.eval(vec(60, 0), vec(60, 180))[0], spec + diff, rel_tol=1e-12)
+
+
+@pytest.mark.parametrize("phi,expo", [(0, 10.0), (90, 40.0), (45, 25.0)])
+def test_audit_anisotropic_exponent(phi, expo):
+    # wo = n, wi tilted by 2·atan(0.1) at azimuth φ: h tilted by θh = atan(0.1), n·h = h·k = 1/sqrt(1.01),
+    # max(n·k1, n·k2) = 1; the exponent is nu cos²φ + nv sin²φ: 10, 40, (10 + 40)/2
+    rs = 0.05
+    m = bk.model("ashikhmin-shirley", rd=0.0, rs=rs, nu=10, nv=40)
+    c = 1 / math.sqrt(1.01)
+    spec = math.sqrt(11 * 41) / (8 * math.pi) * c**expo / (c * 1.0) * (rs + (1 - rs) * (1 - c) ** 5)
+    wi = vec(math.degrees(2 * math.atan(0.1)), phi)
+    assert math.isclose(m.eval(wi, np.array([0.0, 0.0, 1.0]))[0], spec, rel_tol=1e-12)

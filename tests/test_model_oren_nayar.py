@@ -145,3 +145,41 @@ def test_sigma_range():
         bk.model("oren-nayar", sigma=math.pi / 2)
     with pytest.raises(ValueError, match="variant"):
         bk.model("oren-nayar", variant="nope")
+
+
+# --- formula audit: the paper's constants pinned at hand-worked points -------------------------
+# Checked against the restatement in the appendix "Oren-Nayar Diffuse Reflectance Model" and
+# Mitsuba 0.5's roughdiffuse.cpp (see the module docstring). σ = 0.5 (σ² = 0.25), θi = 60°,
+# θo = 30°: α = π/3, β = π/6, sin α = √3/2, tan β = 1/√3, 2β/π = 1/3, 4αβ/π² = 2/9.
+_S2 = 0.25
+_C1 = 1 - 0.5 * _S2 / (_S2 + 0.33)  # 1 − 0.125/0.58
+_K2 = 0.45 * _S2 / (_S2 + 0.09)  # 0.1125/0.34, C2 without its angular factor
+_K3 = 0.125 * _S2 / (_S2 + 0.09)  # 0.03125/0.34, C3 without (4αβ/π²)²
+_K4 = 0.17 * _S2 / (_S2 + 0.13)  # 0.0425/0.38, the interreflection coefficient
+
+
+def test_audit_hand_constants():
+    assert math.isclose(_C1, 0.7844827586206897, rel_tol=1e-15)
+    assert math.isclose(_K2, 0.33088235294117646, rel_tol=1e-15)
+    assert math.isclose(_K3, 0.09191176470588235, rel_tol=1e-15)
+    assert math.isclose(_K4, 0.11184210526315788, rel_tol=1e-15)
+
+
+@pytest.mark.parametrize(
+    "dphi,full_bracket,l2_bracket,qual_bracket",
+    [
+        # cos Δφ = 0: only C1 and C3 tan((α+β)/2) = C3 tan 45° = C3 survive; L2 bracket 1
+        (90, _C1 + _K3 * (2 / 9) ** 2, 1.0, _C1),
+        # cos Δφ = 1: C2 = K2 sin α, C2 tan β = K2/2; C3 is multiplied by 1 − |cos| = 0; L2: 1 − 1/9
+        (0, _C1 + _K2 / 2, 8 / 9, _C1 + _K2 / 2),
+        # cos Δφ = −1: C2 = K2 (sin α − (1/3)³), minus C2 tan β = K2 (1/2 − 1/(27√3)); L2: 1 + 1/9
+        (180, _C1 - _K2 * (0.5 - 1 / (27 * math.sqrt(3))), 10 / 9, _C1),
+    ],
+)
+def test_audit_paper_formula_at_hand_worked_points(dphi, full_bracket, l2_bracket, qual_bracket):
+    rho = 0.6
+    wi, wo = vec(60, 0), vec(30, dphi)
+    full = bk.model("oren-nayar", kd=rho, sigma=0.5, variant="full").eval(wi, wo)[0]
+    assert math.isclose(full, rho / PI * full_bracket + rho * rho / PI * _K4 * l2_bracket, rel_tol=1e-12)
+    qual = bk.model("oren-nayar", kd=rho, sigma=0.5, variant="qualitative").eval(wi, wo)[0]
+    assert math.isclose(qual, rho / PI * qual_bracket, rel_tol=1e-12)

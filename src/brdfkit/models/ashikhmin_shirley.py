@@ -1,7 +1,23 @@
 """Ashikhmin-Shirley: an anisotropic Phong BRDF with a coupled diffuse term.
 
 Reference: M. Ashikhmin and P. Shirley, "An Anisotropic Phong BRDF Model",
-Journal of Graphics Tools 5(2), 2000, 25-32 (eqs. 4 and 5).
+Journal of Graphics Tools 5(2), 2000, 25-32 (the specular term ρ_s and the
+coupled diffuse term ρ_d; the journal text was not available to us, so their
+equation numbers are not cited).
+
+Verification (formula audit): ρ_s (with (h·k)·max(n·k1, n·k2) in the
+denominator, the exponent nu cos²φh + nv sin²φh = (nu (h·u)² + nv (h·v)²)/
+(1 − (h·n)²) and Schlick's Fresnel of h·k) and ρ_d (28 Rd/(23π) (1 − Rs)
+(1 − (1 − n·k1/2)⁵)(1 − (1 − n·k2/2)⁵)) agree term by term with the
+UC Berkeley CS 184 lecture slides (2016, "Ashikhmin-Shirley BRDF", both
+forms of the exponent; the second has a typo, pu twice), a blog article "Ashikhmin-Shirley Lighting Model"
+(both terms written out) and pbrt-v3's `FresnelBlend::f` (the same ρ_d; its
+ρ_s is D(h)/(4 (h·k) max(cos θi, cos θo)) F, which with A&S's normal
+distribution sqrt((nu+1)(nv+1))/(2π) (n·h)^(…) is the formula here). No
+disagreement between these sources and this module was found; nothing was
+changed. (Of the University of Utah technical-report version, "An
+Anisotropic Phong Light Reflection Model", only the introduction and
+parameter list were available to us.)
 
 With k = wi (or wo: h·wi = h·wo), h = normalize(wi + wo) with azimuth φh from
 the tangent +x, n = +z:

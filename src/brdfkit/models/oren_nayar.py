@@ -4,8 +4,24 @@ Reference: M. Oren and S. K. Nayar, "Generalization of Lambert's Reflectance
 Model", SIGGRAPH 1994, pp. 239-246 — the functional approximation of the
 single-scattering radiance L_r^1 (coefficients C1, C2, C3), the
 interreflection component L_r^2, and the "qualitative model" with A and B.
-(The equations are quoted below; their numbers in the paper were not
-checked against the PDF, which was not available to us.)
+
+Verification (formula audit): the paper's own text was not available to us,
+so its equation numbers are NOT cited here. The formulas below were checked,
+constant by constant (0.5, 0.33, 0.45, 0.09, 0.125, (4αβ/π²)², (2β/π)³ in the
+cos Δφ < 0 branch of C2, 0.17, 0.13, (2β/π)²), against two independent
+restatements that agree with each other and with this module:
+
+* the appendix "Oren-Nayar Diffuse Reflectance Model" (studylib.net document
+  18316725), which restates L_r^1 (its eqs. 1-6), L_r^2 (its eq. 7) and their
+  sum (its eq. 8) — those numbers are the appendix's, not the paper's;
+* Mitsuba 0.5 `src/bsdfs/roughdiffuse.cpp` (full model and its
+  `useFastApprox` A, B model; it rescales its roughness input by 1/sqrt(2)
+  before using it as σ, which we do not: our σ is the paper's, the standard
+  deviation of the facet slope angle in radians).
+
+The qualitative A, B model agrees with the lecture, with Mitsuba and with the
+Wikipedia statement of the model. No disagreement between these sources and
+this module was found; nothing was changed.
 
 Angles: θi, θo polar angles of wi and wo, Δφ = φo − φi, α = max(θi, θo),
 β = min(θi, θo), σ the standard deviation of the facet slope angle (radians),

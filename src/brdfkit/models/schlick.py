@@ -27,10 +27,32 @@ split into a Lambertian part a, a glossy part b and an ideal-mirror part c
     b = 4 r (1 − r),   a = 0 and c = 1 − b if r < 0.5,   a = 1 − b and c = 0 if r ≥ 0.5
 
 so r → 0 is a perfect mirror, r = 0.5 purely glossy and r = 1 Lambertian.
-(The paper itself was not available to us: S, Z, A, G and the two slab
-types agree across a published summary of the paper and two public
-implementations; the a/b/c split is as we recall it from the paper and as
-one public implementation has it — it was not checked against the paper.)
+
+Verification (formula audit; the paper's own text was not available to us):
+
+* verified against two independent renderers and a third-party summary of
+  the paper (an auto-generated, chunk-by-chunk digest of the PDF,
+  "Schlick_1994_BRDF_Model - Extracted Summary", in the public repository
+  pjt222/soap_bubble_simulation):
+  S(u) = C + (1 − C)(1 − u)⁵; Z(t) = r/(1 + r t² − t²)²;
+  A(w) = sqrt(p/(p² − p² w² + w²)); G(v) = v/(r − r v + v); the glossy
+  product G(v) G(v') Z(t) A(w)/(4π v v'); the single slab S·D and the double
+  slab S·D + (1 − S) S'·D' with parameter sets (C, r, p) and (C', r', p').
+  The renderers are LuxCoreRender (`SchlickDistribution_SchlickZ/_SchlickA/
+  _SchlickG`, Z A/π as the normal distribution) and RISE (an earlier
+  version of its `SchlickBRDF.cpp`: Z A G G'/(4π v v')). The digest
+  numbers the Fresnel approximation (15) in §4.2 (and the same formula with
+  C as (24) in §5) and the §4.3 form of G,
+  v/(v − k v + k) with k = sqrt(2m²/π), as (19); RISE cites "Eq. 31" for
+  the §5 G(v)G(v') — second-hand numbers, not checked against the paper.
+* the azimuth w: this module takes w = cos of the azimuth of h measured from
+  the tangent +x (so p → 0 gives scratches along +x), as LuxCore does for a
+  positive anisotropy; RISE measures it from its second tangent. The paper's
+  choice of reference axis could not be checked; it only swaps x and y.
+* NOT verified: the a/b/c split (b = 4r(1 − r), a or c = 1 − b). None of the
+  sources available to us states it; it is as the previous author recalled
+  it from the paper, and the auditor recalls the same form, but no document
+  confirms it.
 
 Material types:
 
@@ -47,9 +69,17 @@ What ``eval`` returns and what it does not:
   :meth:`Schlick.mirror_reflectance` gives the delta's weight (the fraction of
   light from wi sent into reflect(wi)): c·S(cos θi), plus (1 − S)·S'·c' for
   the double slab.
-* The paper also discusses a term that re-injects the energy lost to
-  self-shadowing (1 − G(v)G(v')); the secondary sources we could consult
-  disagree on its exact form, so it is **not** implemented.
+* The paper also has a term that re-injects the energy lost to
+  self-shadowing, weighted by 1 − G(v)G(v'). Its exact form stays
+  unresolved, so it is **not** implemented. The sources disagree: the
+  third-party digest writes D = G G' Z A/(4π v v') + (1 − G G')/(4π v v'),
+  whose second term alone has the albedo (1/(4π v))∫(1 − G(v)G(v'))dω',
+  which grows like 1/(2v) at grazing incidence (hardly what a paper that
+  claims energy conservation would propose, so possibly a transcription
+  slip); LuxCoreRender's optional "multibounce" term, which its source
+  calls an "alternative", is clamp((1 − G G')/(4 v v'), 0, 1), without π;
+  and the auditor recalls (1 − G G')/π, a Lambertian lobe, without a
+  document to confirm it.
 
 Properties: every factor is symmetric in wi and wo (u, t, w, and the product
 G(v)G(v')), so the model is reciprocal. Energy: Z/π is a normalised
