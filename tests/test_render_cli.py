@@ -1,0 +1,102 @@
+"""``brdfkit render`` and ``brdfkit gallery`` on the command line."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from brdfkit.cli import main
+
+
+def test_render_flags(tmp_path, capsys):
+    out = tmp_path / "ct.png"
+    rc = main(["render", "--model", "cook-torrance", "-p", "m=0.3", "--shading", "phong", "--size", "80x60",
+               "--mesh", "sphere", "-o", str(out), "--json"])
+    assert rc == 0
+    info = json.loads(capsys.readouterr().out)
+    assert info["material"] == "cook-torrance" and info["shading"] == "phong" and info["srgb"] is True
+    img = np.asarray(Image.open(out))
+    assert img.shape == (60, 80, 3)
+    assert img.max() > 200 and img[0, 0].max() == 0  # a lit object on the black background
+
+
+def test_render_scene_file(tmp_path, capsys):
+    import trimesh
+
+    from brdfkit.render import meshes
+
+    s = meshes.sphere(12, 6)
+    trimesh.Trimesh(vertices=s.positions, faces=s.faces, process=False).export(tmp_path / "ball.obj")
+    scene = {
+        "mesh": "ball.obj",  # relative to the scene file
+        "camera": {"eye": [0, 0, 4], "target": [0, 0, 0], "up": [0, 1, 0], "fov_deg": 35},
+        "size": [48, 40],
+        "lights": [{"position": [1, 1, 2, 1], "diffuse": [1, 1, 1], "spot_cutoff": 30,
+                    "spot_direction": [-0.3, -0.3, -1]}],
+        "light_model": {"ambient": [0.1, 0.1, 0.1], "local_viewer": True},
+        "material": {"opengl": {"ambient": [0.1, 0, 0], "diffuse": [0.7, 0.1, 0.1], "specular": [1, 1, 1],
+                                "emission": [0, 0, 0], "shininess": 40}},
+        "shading": "gouraud",
+        "background": [0, 0, 1, 1],
+        "antialias": False,
+    }
+    (tmp_path / "scene.json").write_text(json.dumps(scene))
+    rc = main(["render", "--scene", str(tmp_path / "scene.json"), "-o", str(tmp_path / "out.png")])
+    assert rc == 0
+    img = np.asarray(Image.open(tmp_path / "out.png"))
+    assert img.shape == (40, 48, 3)
+    assert tuple(img[0, 0]) == (0, 0, 255)  # the background colour, unencoded
+    # flags override the scene file
+    rc = main(["render", "--scene", str(tmp_path / "scene.json"), "--size", "20x20", "-o", str(tmp_path / "o.exr")])
+    assert rc == 0
+    from brdfkit.render.image import read_exr
+
+    assert read_exr(tmp_path / "o.exr").shape == (20, 20, 4)
+
+
+@pytest.mark.parametrize(
+    "args, fragment",
+    [
+        (["--model", "nope"], "unknown model"),
+        (["--model", "ward", "-p", "alpha_x=5"], "alpha_x"),
+        (["--opengl", "gold", "--model", "ward"], "only one of"),
+        (["--opengl", "gold", "--shading", "toon"], "shading"),
+        (["--opengl", "gold", "--size", "0x4"], "--size"),
+        (["--scene", "/nonexistent/scene.json"], "not found"),
+        (["--mesh", "/nonexistent/x.obj"], "not found"),
+        (["--opengl", "gold", "--tonemap", "filmic"], "tonemap"),
+    ],
+)
+def test_render_errors_are_one_line(tmp_path, capsys, args, fragment):
+    rc = main(["render", *args, "-o", str(tmp_path / "x.png")])
+    err = capsys.readouterr().err
+    assert rc != 0
+    assert fragment in err and "Traceback" not in err and len(err.strip().splitlines()) == 1
+
+
+def test_render_bad_output_suffix(tmp_path, capsys):
+    rc = main(["render", "--opengl", "gold", "-o", str(tmp_path / "x.jpg")])
+    assert rc != 0 and ".png" in capsys.readouterr().err
+
+
+def test_gallery(tmp_path, capsys):
+    rc = main(["gallery", "-o", str(tmp_path / "g"), "--size", "48", "--only", "materials",
+               "--only", "gouraud-vs-phong", "--json"])
+    assert rc == 0
+    files = json.loads(capsys.readouterr().out)
+    assert [p.rsplit("/", 1)[-1] for p in files] == ["materials.png", "gouraud-vs-phong.png"]
+    img = np.asarray(Image.open(files[0]))
+    assert img.shape[1] > 6 * 48 and img.shape[0] > 2 * 48  # 6 x 2 labelled panels
+    rc = main(["gallery", "--only", "nope", "-o", str(tmp_path / "g")])
+    assert rc != 0 and "unknown figure" in capsys.readouterr().err
+
+
+def test_render_measured_material(tmp_path, capsys):
+    rc = main(["render", "--measured", "merl/aluminium", "--mesh", "sphere", "--size", "32", "-o",
+               str(tmp_path / "al.png"), "--json"])
+    assert rc == 0
+    assert json.loads(capsys.readouterr().out)["size"] == [32, 32]
+    assert np.asarray(Image.open(tmp_path / "al.png")).max() > 50
