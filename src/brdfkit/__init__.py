@@ -15,9 +15,9 @@ from .models.base import BRDF
 __version__ = "0.1.0"
 
 
-def models() -> list[str]:
-    """Registry names of every analytic model."""
-    return registry.names()
+# ``models`` is the package brdfkit.models, made callable: ``bk.models()`` lists the
+# registry names (SPEC) and ``import brdfkit.models.ward`` still works.
+from . import models  # noqa: E402
 
 
 def model_info(name: str) -> dict[str, Any]:
@@ -31,3 +31,42 @@ def model(name: str, **params: Any) -> BRDF:
 
 
 __all__ = ["BRDF", "models", "model_info", "model", "geometry", "params", "registry", "__version__"]
+
+
+# -- measured data and fitting (brdfkit.measured; imported on first use) -------------
+def load_merl(path, interpolation: str = "nearest"):
+    """Read a MERL ``.binary`` file as a model (see :mod:`brdfkit.measured.merl`)."""
+    from .measured.merl import load_merl as _f
+
+    return _f(path, interpolation=interpolation)
+
+
+def save_merl(model, path) -> None:
+    """Tabulate an isotropic model into a MERL ``.binary`` file."""
+    from .measured.merl import save_merl as _f
+
+    _f(model, path)
+
+
+def material(name: str):
+    """A built-in measured material as a model, e.g. ``material("merl/gold-metallic-paint")``."""
+    from .measured.nbrdf import material as _f
+
+    return _f(name)
+
+
+def materials() -> list[str]:
+    """Names of the 159 built-in measured materials (``merl/…``, ``rgl/…``, ``nielsen/…``)."""
+    from .measured.nbrdf import materials as _f
+
+    return list(_f())
+
+
+def fit(name: str, measured, fixed=None, metric: str = "ngan", **kw):
+    """Fit analytic model ``name`` to measured data (see :func:`brdfkit.measured.fit.fit`)."""
+    from .measured.fit import fit as _f
+
+    return _f(name, measured, fixed=fixed, metric=metric, **kw)
+
+
+__all__ += ["load_merl", "save_merl", "material", "materials", "fit"]

@@ -1,0 +1,549 @@
+"""Fitting analytic models to measured BRDFs.
+
+``fit(name, measured, fixed={...}, metric="ngan")`` finds the parameters of the
+registered model ``name`` that best reproduce ``measured`` (a MERL file, a
+built-in material name, or any isotropic model), generically over the model's
+parameter spec: every ``scalar``/``rgb`` parameter with ``fit=True`` is free
+(an rgb parameter is three free values) within ``Param.fit_range`` or else
+``Param.range``; choices, booleans, integers and ``fixed`` parameters keep their
+value. Parameters flagged ``log_scale`` are optimised in log space.
+
+Data. A few thousand (θh, θd, φd) samples, uniform in MERL's index space (the
+square-root θh mapping puts many of them in the specular peak), with random
+φh; both directions within ``max_theta_deg`` (80°, as Ngan et al. 2005) of the
+normal. From a MERL table the samples are bin centres of measured bins and the
+values are the table's; from any other model the model is evaluated. Each
+sample carries the weight ``sin θh · dθh/du · sin θd cos θd`` (the Jacobian of
+the half/difference parameterisation over the sampling density), so every
+metric below estimates an integral over pairs of directions (ωi, ωo), normalised
+by the integral of the weight.
+
+Metrics (``METRICS``), weighted RMS over samples and the three channels of a
+transform ``T`` of the measured and the fitted values:
+
+==========  =========================  =============================================
+metric      T(f)                       source
+==========  =========================  =============================================
+``ngan``    f · cos θi                 Ngan, Durand & Matusik, "Experimental analysis
+                                       of BRDF models", EGSR 2005 (the default)
+``l2``      f                          plain L2 of the BRDF values
+``log``     ln(1 + f · cos θi)         log-compressed (tames specular peaks)
+``cbrt``    (f · cos θi)^(1/3)         Forés, Ferwerda & Gu, "Toward a perceptually
+                                       based metric for BRDF modeling", CIC 2012
+==========  =========================  =============================================
+
+Optimiser: ``scipy.optimize.least_squares`` (trust-region reflective, bounds)
+from several starts: the parameters' defaults plus the best of a few dozen
+random points of the bounded parameter space (multi-start, so a local minimum
+does not decide); the best result wins.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import time
+from dataclasses import dataclass, field
+from typing import Any, Callable, Iterable, Mapping
+
+import numpy as np
+
+from ..geometry import from_rusinkiewicz
+from ..models.base import BRDF
+from ..params import Param, to_jsonable
+from .merl import HALF_PI, MERLBRDF, RES_PHI_D, RES_THETA_D, RES_THETA_H, load_merl
+
+METRICS = ("ngan", "l2", "log", "cbrt")
+METRIC_TITLES = {
+    "ngan": "cosine-weighted RMS (Ngan, Durand & Matusik 2005)",
+    "l2": "RMS of the BRDF values (plain L2)",
+    "log": "RMS of ln(1 + f cos θi)",
+    "cbrt": "RMS of the cube root of f cos θi (Forés, Ferwerda & Gu 2012)",
+}
+
+
+# --------------------------------------------------------------------------- data
+@dataclass
+class Samples:
+    """Measured samples: directions, values (N, 3) in 1/sr, weights (N,) with mean 1."""
+
+    wi: np.ndarray
+    wo: np.ndarray
+    f: np.ndarray
+    w: np.ndarray
+    source: str = ""
+
+    @property
+    def cos_i(self) -> np.ndarray:
+        return self.wi[:, 2]
+
+    def __len__(self) -> int:
+        return len(self.w)
+
+
+def resolve_source(measured: Any) -> BRDF:
+    """A model from a MERL path, a built-in material name or a model instance."""
+    if isinstance(measured, BRDF):
+        return measured
+    if isinstance(measured, (str, os.PathLike)):
+        s = os.fspath(measured)
+        if os.path.exists(s) or s.endswith((".binary", ".bin")):
+            return load_merl(s)  # OSError if missing
+        from .nbrdf import SETS, material
+
+        looks_like_path = s.startswith((".", os.sep, "~")) or "." in os.path.basename(s) or (
+            os.sep in s and s.split(os.sep, 1)[0] not in SETS
+        )
+        if looks_like_path:
+            raise ValueError(f"{s}: no such MERL file (and not a built-in material; see `brdfkit list --measured`)")
+        return material(s)
+    raise ValueError(f"measured data must be a MERL file path, a material name or a model, got {type(measured).__name__}")
+
+
+def _source_label(model: BRDF) -> str:
+    return getattr(model, "label", None) or getattr(model, "name", "model")
+
+
+def sample(measured: Any, n: int = 3000, seed: int = 0, max_theta_deg: float = 80.0) -> Samples:
+    """``n`` weighted samples of a measured material / model (see the module docstring)."""
+    model = resolve_source(measured)
+    if not getattr(model, "isotropic", True):
+        raise ValueError(f"{_source_label(model)}: fitting needs isotropic measured data")
+    if not (0 < max_theta_deg <= 90):
+        raise ValueError(f"max_theta_deg must be in (0, 90], got {max_theta_deg}")
+    if n < 16:
+        raise ValueError(f"need at least 16 samples, got {n}")
+    rng = np.random.default_rng(seed)
+    cos_max = math.cos(math.radians(max_theta_deg)) if max_theta_deg < 90 else 0.0
+    is_table = isinstance(model, MERLBRDF)
+    wi_l, wo_l, f_l, w_l = [], [], [], []
+    have = 0
+    for _round in range(20):
+        m = max(4 * n, 4096)
+        if is_table:
+            i = rng.integers(0, RES_THETA_H, m)
+            j = rng.integers(0, RES_THETA_D, m)
+            k = rng.integers(0, RES_PHI_D, m)
+            u = (i + 0.5) / RES_THETA_H
+            td = (j + 0.5) / RES_THETA_D * HALF_PI
+            pd = (k + 0.5) / RES_PHI_D * np.pi
+        else:
+            u = rng.random(m)
+            td = rng.random(m) * HALF_PI
+            pd = rng.random(m) * np.pi
+        th = u * u * HALF_PI
+        ph = rng.random(m) * 2 * np.pi
+        # reciprocity: half of the samples with wi and wo swapped (φd + π)
+        pd = pd + np.pi * (rng.random(m) < 0.5)
+        wi, wo = from_rusinkiewicz(th, ph, td, pd)
+        ok = (wi[:, 2] > cos_max) & (wo[:, 2] > cos_max)
+        if is_table:
+            v = np.moveaxis(model.table[:, i, j, k], 0, -1)
+            ok &= (v >= 0).all(axis=-1)
+        idx = np.flatnonzero(ok)[: n - have]
+        if idx.size == 0:
+            continue
+        if is_table:
+            fv = v[idx]
+        else:
+            fv = np.asarray(model.eval(wi[idx], wo[idx]), dtype=np.float64)
+        wts = np.sin(th[idx]) * (np.pi * u[idx]) * np.sin(td[idx]) * np.cos(td[idx])
+        wi_l.append(wi[idx])
+        wo_l.append(wo[idx])
+        f_l.append(fv)
+        w_l.append(wts)
+        have += idx.size
+        if have >= n:
+            break
+    if have < 16:
+        raise ValueError(f"{_source_label(model)}: too few measured samples within {max_theta_deg}° ({have})")
+    w = np.concatenate(w_l)
+    f = np.concatenate(f_l)
+    if not np.isfinite(f).all():
+        raise ValueError(f"{_source_label(model)}: measured values are not finite")
+    return Samples(np.concatenate(wi_l), np.concatenate(wo_l), f, w / w.mean(), _source_label(model))
+
+
+def _transform(metric: str) -> Callable[[np.ndarray, np.ndarray], np.ndarray]:
+    if metric == "ngan":
+        return lambda f, c: f * c
+    if metric == "l2":
+        return lambda f, c: f
+    if metric == "log":
+        return lambda f, c: np.log1p(np.maximum(f * c, 0.0))
+    if metric == "cbrt":
+        return lambda f, c: np.cbrt(np.maximum(f * c, 0.0))
+    raise ValueError(f"unknown metric {metric!r}; valid metrics: {', '.join(METRICS)}")
+
+
+def error(model: BRDF, samples: Samples, metric: str = "ngan") -> float:
+    """The metric's weighted RMS error of ``model`` against ``samples``."""
+    T = _transform(metric)
+    c = samples.cos_i[:, None]
+    d = T(np.asarray(model.eval(samples.wi, samples.wo), np.float64), c) - T(samples.f, c)
+    return float(np.sqrt(np.mean(samples.w[:, None] * d * d)))
+
+
+# --------------------------------------------------------------------------- parameters
+@dataclass
+class _Slot:
+    param: Param
+    channel: int | None  # None for a scalar
+    lo: float
+    hi: float
+    log: bool
+
+    def to_x(self, v: float) -> float:
+        v = min(max(v, self.lo), self.hi)
+        return math.log(v) if self.log else v
+
+    def from_x(self, x: float) -> float:
+        v = math.exp(x) if self.log else x
+        return min(max(v, self.lo), self.hi)
+
+
+def _bounds(p: Param) -> tuple[float, float, bool]:
+    rng = p.fit_range or p.range
+    if rng is None:
+        raise ValueError(f"parameter '{p.name}' has no range; it cannot be fitted (fix it with fixed={{...}})")
+    lo, hi = float(rng[0]), float(rng[1])
+    if p.range is not None:  # never outside the spec's range
+        lo, hi = max(lo, float(p.range[0])), min(hi, float(p.range[1]))
+    if math.isinf(hi):
+        hi = max(1e4, 100 * abs(lo)) if p.log_scale else max(10.0, 10 * abs(lo))
+    if math.isinf(lo):
+        lo = -hi
+    log = bool(p.log_scale)
+    if log and lo <= 0:
+        lo = hi * 1e-5
+    span = hi - lo
+    if p.open_lo:
+        lo = lo * (1 + 1e-6) if log else lo + max(1e-9, 1e-6 * span)
+    if p.open_hi:
+        hi = hi - max(1e-9, 1e-6 * span)
+    if not lo < hi:
+        raise ValueError(f"parameter '{p.name}': empty fitting range [{lo}, {hi}]")
+    return lo, hi, log
+
+
+# Anisotropic models fitted to isotropic data: these pairs share one free value.
+ISOTROPIC_TIES = (("alpha_x", "alpha_y"), ("nu", "nv"), ("n_u", "n_v"), ("alpha_u", "alpha_v"), ("m_x", "m_y"))
+
+
+class ParamPacker:
+    """Maps between a model's parameter dict and the free vector the optimiser sees.
+
+    Free: every ``scalar``/``rgb`` parameter with ``fit=True`` not in ``fixed``
+    (rgb: three slots). For an anisotropic model fitted to isotropic data
+    (``tie_isotropic``), each pair of :data:`ISOTROPIC_TIES` is one slot. The
+    model is built from ``fixed`` plus the free values only; everything else
+    takes the model's own default.
+    """
+
+    def __init__(self, cls: type[BRDF], fixed: Mapping[str, Any] | None = None, tie_isotropic: bool = True) -> None:
+        fixed = dict(fixed or {})
+        by_name = {p.name: p for p in cls.spec}
+        for k in fixed:
+            if k not in by_name:
+                raise ValueError(f"{cls.name}: unknown parameter '{k}'; valid parameters: {', '.join(by_name) or '(none)'}")
+        self.cls = cls
+        self.given = {k: by_name[k].validate(cls.name, v) for k, v in fixed.items()}
+        self.fixed_names = set(fixed)
+        self.defaults = {p.name: p.validate(cls.name, p.default) for p in cls.spec}
+        self.fixed = dict(self.defaults, **self.given)
+        tied: dict[str, str] = {}
+        if tie_isotropic and not getattr(cls, "isotropic", True):
+            for a, b in ISOTROPIC_TIES:
+                if a in by_name and b in by_name and a not in fixed and b not in fixed \
+                        and by_name[a].fit and by_name[b].fit:
+                    tied[a] = b
+        self.tied = tied
+        skip = set(tied.values())
+        self.slots: list[_Slot] = []
+        for p in cls.spec:
+            if p.name in fixed or p.name in skip or not p.fit or p.kind not in ("scalar", "rgb"):
+                continue
+            lo, hi, log = _bounds(p)
+            if p.kind == "scalar":
+                self.slots.append(_Slot(p, None, lo, hi, log))
+            else:
+                for c in range(3):
+                    self.slots.append(_Slot(p, c, lo, hi, log))
+        self._update_bounds()
+
+    def _update_bounds(self) -> None:
+        self.free_names = list(dict.fromkeys(s.param.name for s in self.slots))
+        self.lb = np.array([s.to_x(s.lo) for s in self.slots])
+        self.ub = np.array([s.to_x(s.hi) for s in self.slots])
+
+    def freeze(self, indices: Iterable[int]) -> None:
+        """Hold some slots at their default (e.g. parameters the chosen options do not use)."""
+        drop = set(indices)
+        names = {self.slots[i].param.name for i in drop}
+        # an rgb parameter is frozen only as a whole
+        names = {n for n in names if all(i in drop for i, s in enumerate(self.slots) if s.param.name == n)}
+        self.slots = [s for s in self.slots if s.param.name not in names]
+        self.frozen = sorted(set(getattr(self, "frozen", [])) | names)
+        self._update_bounds()
+
+    def __len__(self) -> int:
+        return len(self.slots)
+
+    def params(self, x: np.ndarray) -> dict[str, Any]:
+        out = dict(self.given)
+        for n in getattr(self, "frozen", []):
+            out[n] = self.defaults[n]
+        rgb: dict[str, list[float]] = {}
+        for s, xv in zip(self.slots, x):
+            v = s.from_x(float(xv))
+            if s.channel is None:
+                out[s.param.name] = v
+                if s.param.name in self.tied:
+                    out[self.tied[s.param.name]] = v
+            else:
+                rgb.setdefault(s.param.name, [0.0, 0.0, 0.0])[s.channel] = v
+        for k, v in rgb.items():
+            out[k] = np.array(v)
+        return out
+
+    def model(self, x: np.ndarray) -> BRDF:
+        return self.cls(**self.params(x))
+
+    def x_of(self, params: Mapping[str, Any]) -> np.ndarray:
+        x = []
+        for s in self.slots:
+            v = params[s.param.name]
+            v = float(np.asarray(v).reshape(-1)[s.channel] if s.channel is not None and np.ndim(v) else v)
+            x.append(s.to_x(v))
+        return np.clip(np.array(x), self.lb, self.ub)
+
+    def random_x(self, rng: np.random.Generator, n: int) -> np.ndarray:
+        """Random points; an rgb parameter gets a random grey level with a little colour."""
+        xs = rng.uniform(self.lb, self.ub, size=(n, len(self.slots)))
+        names = [s.param.name for s in self.slots]
+        for name in dict.fromkeys(names):
+            cols = [i for i, nm in enumerate(names) if nm == name]
+            if len(cols) == 3:
+                base = xs[:, cols[0]][:, None]
+                span = (self.ub[cols] - self.lb[cols])[None, :]
+                xs[:, cols] = np.clip(base + rng.normal(0, 0.1, (n, 3)) * span, self.lb[cols], self.ub[cols])
+        return xs
+
+
+# --------------------------------------------------------------------------- the fit
+@dataclass
+class FitResult:
+    """The outcome of :func:`fit`: the fitted model, its parameters and its error."""
+
+    model: BRDF
+    params: dict[str, Any]
+    error: float
+    metric: str
+    source: str
+    samples: int
+    starts: int
+    nfev: int
+    seconds: float
+    fixed: list[str] = field(default_factory=list)
+    unused: list[str] = field(default_factory=list)
+    start_errors: list[float] = field(default_factory=list)
+    n_free: int = 0
+
+    def to_json(self) -> dict[str, Any]:
+        return {
+            "model": self.model.name,
+            "source": self.source,
+            "params": to_jsonable(self.params),
+            "error": self.error,
+            "metric": self.metric,
+            "metric_title": METRIC_TITLES[self.metric],
+            "fixed": self.fixed,
+            "unused": self.unused,
+            "free_values": self.n_free,
+            "samples": self.samples,
+            "starts": self.starts,
+            "nfev": self.nfev,
+            "seconds": round(self.seconds, 3),
+        }
+
+    def __repr__(self) -> str:
+        return f"FitResult({self.model!r}, error={self.error:.6g}, metric={self.metric!r})"
+
+
+def _freeze_unused(packer: ParamPacker, residuals, rng: np.random.Generator) -> None:
+    """Freeze slots that change nothing at the defaults nor at a random point (unused options)."""
+    if len(packer) == 0:
+        return
+    pts = [packer.x_of(packer.fixed), packer.random_x(rng, 1)[0]]
+    unused = set(range(len(packer)))
+    for x in pts:
+        r0 = residuals(x)
+        for i in list(unused):
+            y = x.copy()
+            mid = 0.5 * (packer.lb[i] + packer.ub[i])
+            y[i] = x[i] + 0.25 * (mid - x[i]) + 0.05 * (packer.ub[i] - packer.lb[i]) * (1 if x[i] <= mid else -1)
+            if np.any(residuals(y) != r0):
+                unused.discard(i)
+    if unused and len(unused) < len(packer):
+        packer.freeze(unused)
+
+
+def fit(
+    name: str | type[BRDF],
+    measured: Any,
+    fixed: Mapping[str, Any] | None = None,
+    metric: str = "ngan",
+    *,
+    starts: int = 4,
+    candidates: int = 48,
+    samples: int = 3000,
+    seed: int = 0,
+    max_theta_deg: float = 80.0,
+    max_nfev: int | None = None,
+    tol: float = 1e-8,
+    progress: bool | Callable[[int, int], None] = False,
+    data: Samples | None = None,
+) -> FitResult:
+    """Fit the registered analytic model ``name`` (or a :class:`BRDF` subclass) to ``measured``.
+
+    ``measured``: a MERL file path, a built-in material name (``"merl/chrome"``) or a
+    model (e.g. :func:`brdfkit.load_merl`'s). ``fixed``: parameters held at the given
+    values. ``metric``: one of :data:`METRICS`. ``starts``: local optimisations run
+    (from the defaults and the best of ``candidates`` random points). ``data``:
+    precomputed :func:`sample` output (then ``measured`` only names the source).
+    Returns a :class:`FitResult` (``params`` holds every parameter of the model).
+    """
+    from scipy.optimize import least_squares
+
+    from .. import registry
+
+    t0 = time.perf_counter()
+    if metric not in METRICS:
+        raise ValueError(f"unknown metric {metric!r}; valid metrics: {', '.join(METRICS)}")
+    if starts < 1:
+        raise ValueError(f"starts must be at least 1, got {starts}")
+    cls = name if isinstance(name, type) and issubclass(name, BRDF) else registry.get(name)
+    packer = ParamPacker(cls, fixed)
+    if data is None:
+        data = sample(measured, n=samples, seed=seed, max_theta_deg=max_theta_deg)
+    T = _transform(metric)
+    c = data.cos_i[:, None]
+    target = T(data.f, c)
+    sw = np.sqrt(data.w)[:, None]
+    scale = 1.0 / math.sqrt(target.size)
+
+    def residuals(x: np.ndarray) -> np.ndarray:
+        f = np.asarray(packer.model(x).eval(data.wi, data.wo), np.float64)
+        return (sw * (T(f, c) - target)).ravel() * scale
+
+    def cost(x: np.ndarray) -> float:
+        r = residuals(x)
+        return float(r @ r)
+
+    nfev = 0
+    if len(packer) == 0:  # nothing free: just evaluate
+        x_best = np.zeros(0)
+        err = math.sqrt(cost(x_best))
+        model = packer.model(x_best)
+        return FitResult(model, dict(model.params), err, metric, data.source, len(data), 0, 1,
+                         time.perf_counter() - t0, sorted(packer.fixed_names), [], [err])
+    # from here on the model is built from the free values
+
+
+    rng = np.random.default_rng(seed + 1)
+    _freeze_unused(packer, residuals, rng)
+    nfev += 3 * (len(packer) + 1)
+    x_default = packer.x_of(packer.fixed)
+    cand = [x_default]
+    if candidates > 0:
+        cand += list(packer.random_x(rng, candidates))
+    costs = np.array([cost(x) for x in cand])
+    nfev += len(cand)
+    order = [0] + [int(i) for i in np.argsort(costs) if i != 0]
+    chosen = order[:starts]
+
+    total = len(chosen)
+    bar_ctx = None
+    callback = progress if callable(progress) else None
+    if progress is True:
+        from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
+
+        bar_ctx = Progress(
+            TextColumn(f"fit {cls.name} ← {data.source}"), BarColumn(), TextColumn("{task.completed}/{task.total} starts"),
+            TimeElapsedColumn(), transient=True,
+        )
+        bar_ctx.start()
+        task = bar_ctx.add_task("fit", total=total)
+    best_x, best_cost = None, math.inf
+    start_errors = []
+    iters: list[int] = []
+    try:
+        for n_done, ci in enumerate(chosen, 1):
+            x0 = np.clip(cand[ci], packer.lb, packer.ub)
+            # least_squares needs x0 strictly inside the bounds
+            eps = 1e-9 * np.maximum(1.0, packer.ub - packer.lb)
+            x0 = np.minimum(np.maximum(x0, packer.lb + eps), packer.ub - eps)
+            res = least_squares(
+                residuals, x0, bounds=(packer.lb, packer.ub), method="trf", x_scale="jac", tr_solver="lsmr",
+                max_nfev=max_nfev or 100, xtol=tol, ftol=tol, gtol=tol,
+            )
+            nfev += int(res.nfev) + int(res.njev or 0) * len(packer)
+            iters.append(int(res.nfev))
+            cst = float(2 * res.cost)
+            start_errors.append(math.sqrt(cst))
+            if cst < best_cost:
+                best_cost, best_x = cst, res.x
+            if bar_ctx is not None:
+                bar_ctx.update(task, advance=1)
+            if callback is not None:
+                callback(n_done, total)
+    finally:
+        if bar_ctx is not None:
+            bar_ctx.stop()
+    model = packer.model(best_x)
+    err = error(model, data, metric)
+    return FitResult(
+        model, dict(model.params), err, metric, data.source, len(data), total, nfev,
+        time.perf_counter() - t0, sorted(packer.fixed_names), list(getattr(packer, "frozen", [])), start_errors,
+        len(packer),
+    )
+
+
+def fit_batch(
+    names: Iterable[str],
+    sources: Iterable[str],
+    metric: str = "ngan",
+    fixed: Mapping[str, Mapping[str, Any]] | None = None,
+    progress: bool = True,
+    **kw: Any,
+) -> list[FitResult]:
+    """Fit every model in ``names`` to every source; the samples of a source are shared by the models."""
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
+
+    names = list(names)
+    sources = list(sources)
+    fixed = fixed or {}
+    out: list[FitResult] = []
+    samp_kw = {k: kw.pop(k) for k in ("samples", "seed", "max_theta_deg") if k in kw}
+    n_samp = samp_kw.pop("samples", 3000)
+    import sys
+
+    log_lines = progress and not sys.stderr.isatty()  # a log file: one plain line per material
+    t0 = time.perf_counter()
+    with Progress(
+        TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
+        TimeRemainingColumn(), disable=not progress or log_lines,
+    ) as bar:
+        task = bar.add_task("fitting", total=len(names) * len(sources))
+        for n_src, src in enumerate(sources, 1):
+            if log_lines:
+                print(f"[{n_src}/{len(sources)}] {src} ({time.perf_counter() - t0:.0f} s)", file=sys.stderr, flush=True)
+            data = sample(src, n=n_samp, **samp_kw)
+            for nm in names:
+                bar.update(task, description=f"{nm:>18} ← {data.source}")
+                out.append(fit(nm, src, fixed=fixed.get(nm), metric=metric, data=data, seed=samp_kw.get("seed", 0), **kw))
+                bar.update(task, advance=1)
+    return out
+
+
+__all__ = ["fit", "fit_batch", "FitResult", "Samples", "sample", "error", "METRICS", "METRIC_TITLES", "ParamPacker"]

@@ -1,0 +1,127 @@
+"""The fit report (``brdfkit fit ... --report DIR``): measured vs fitted, side by side.
+
+Writes into DIR
+
+* ``slices.png``: f_r in the plane of incidence for three incidence angles,
+  measured (solid) and fitted (dashed), per RGB channel, log scale;
+* ``spheres.png``: a sphere lit by a directional key light and a weaker fill
+  light, shaded with the measured and with the fitted BRDF (same exposure);
+* ``fit.json`` (the fit result) and ``index.md`` tying them together.
+
+The spheres are shaded in numpy (orthographic camera looking down −z, radiance
+``Σ f_r(wi, wo) · cos θi · E`` per light, exposure from the measured image's
+99.5th percentile, sRGB-like gamma 1/2.2).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from typing import Any
+
+import numpy as np
+
+from ..geometry import frame_from_normal, normalize, spherical_to_vector, to_local
+
+SLICE_THETA_I_DEG = (20.0, 45.0, 70.0)
+LIGHTS = ((np.array([-0.55, 0.45, 0.70]), 1.0), (np.array([0.7, -0.2, 0.5]), 0.25))
+
+
+def plane_slice(model, theta_i_deg: float, n: int = 361) -> tuple[np.ndarray, np.ndarray]:
+    """``(θo in degrees, signed; f (n, 3))`` with the light at φ = 180° and θo > 0 on the mirror side."""
+    t = np.radians(np.linspace(-89.5, 89.5, n))
+    wi = spherical_to_vector(np.radians(theta_i_deg), np.pi)
+    wo = np.stack([np.sin(t), np.zeros_like(t), np.cos(t)], axis=-1)
+    return np.degrees(t), np.asarray(model.eval(np.broadcast_to(wi, wo.shape), wo), np.float64)
+
+
+def shade_sphere(model, size: int = 160) -> np.ndarray:
+    """Linear radiance image ``(size, size, 3)`` of a unit sphere (black background)."""
+    y, x = np.mgrid[1 : -1 : size * 1j, -1 : 1 : size * 1j]
+    r2 = x * x + y * y
+    inside = r2 < 1.0
+    n = np.stack([x[inside], y[inside], np.sqrt(1.0 - r2[inside])], axis=-1)
+    t, b = frame_from_normal(n)
+    view = np.broadcast_to(np.array([0.0, 0.0, 1.0]), n.shape)
+    wo = to_local(view, t, b, n)
+    img = np.zeros((size, size, 3))
+    acc = np.zeros((n.shape[0], 3))
+    for direction, power in LIGHTS:
+        L = np.broadcast_to(normalize(direction), n.shape)
+        wi = to_local(L, t, b, n)
+        f = np.asarray(model.eval(wi, wo), np.float64)
+        acc += f * np.maximum(wi[:, 2:3], 0.0) * power
+    img[inside] = acc
+    return img
+
+
+def _tonemap(img: np.ndarray, exposure: float) -> np.ndarray:
+    return np.clip(img * exposure, 0.0, 1.0) ** (1 / 2.2)
+
+
+def write_report(result, measured, out_dir: str) -> dict[str, Any]:
+    """Write the report of a :class:`~brdfkit.measured.fit.FitResult`; returns the file paths."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    os.makedirs(out_dir, exist_ok=True)
+    fitted = result.model
+    colors = ("tab:red", "tab:green", "tab:blue")
+
+    # -- polar slices -------------------------------------------------------------
+    fig, axes = plt.subplots(1, len(SLICE_THETA_I_DEG), figsize=(4.2 * len(SLICE_THETA_I_DEG), 3.8), dpi=100)
+    for ax, ti in zip(np.atleast_1d(axes), SLICE_THETA_I_DEG):
+        th, fm = plane_slice(measured, ti)
+        _, ff = plane_slice(fitted, ti)
+        for c in range(3):
+            ax.plot(th, np.maximum(fm[:, c], 1e-4), color=colors[c], lw=1.5)
+            ax.plot(th, np.maximum(ff[:, c], 1e-4), color=colors[c], lw=1.2, ls="--")
+        ax.axvline(ti, color="0.6", lw=0.8, ls=":")
+        ax.set_yscale("log")
+        ax.set_xlim(-90, 90)
+        ax.set_xlabel("θo in the plane of incidence (°)")
+        ax.set_title(f"θi = {ti:g}°")
+        ax.grid(True, which="both", alpha=0.25)
+    np.atleast_1d(axes)[0].set_ylabel("f_r (1/sr)")
+    fig.suptitle(f"{result.source}: measured (solid) vs {fitted.name} fit (dashed), error {result.error:.4g} ({result.metric})")
+    fig.tight_layout()
+    slices = os.path.join(out_dir, "slices.png")
+    fig.savefig(slices)
+    plt.close(fig)
+
+    # -- spheres ---------------------------------------------------------------------
+    im_m = shade_sphere(measured)
+    im_f = shade_sphere(fitted)
+    lit = im_m[im_m.sum(axis=-1) > 0]
+    ref = float(np.percentile(lit.max(axis=-1), 99.5)) if lit.size else 1.0
+    exposure = 1.0 / ref if ref > 0 else 1.0
+    fig, axes = plt.subplots(1, 2, figsize=(7, 3.8), dpi=100)
+    for ax, im, title in zip(axes, (im_m, im_f), ("measured: " + result.source, f"fitted: {fitted.name}")):
+        ax.imshow(_tonemap(im, exposure), interpolation="nearest")
+        ax.set_title(title, fontsize=10)
+        ax.axis("off")
+    fig.tight_layout()
+    spheres = os.path.join(out_dir, "spheres.png")
+    fig.savefig(spheres, facecolor="white")
+    plt.close(fig)
+
+    js = os.path.join(out_dir, "fit.json")
+    with open(js, "w") as fh:
+        json.dump(result.to_json(), fh, indent=2)
+    index = os.path.join(out_dir, "index.md")
+    params = result.to_json()["params"]
+    with open(index, "w") as fh:
+        fh.write(f"# Fit of `{fitted.name}` to `{result.source}`\n\n")
+        fh.write(f"Error {result.error:.6g} (metric `{result.metric}`), {result.samples} samples, "
+                 f"{result.starts} starts, {result.seconds:.1f} s.\n\n")
+        fh.write("| parameter | value |\n|---|---|\n")
+        for k, v in params.items():
+            if isinstance(v, list):
+                v = ", ".join(f"{x:.4g}" for x in v)
+            elif isinstance(v, float):
+                v = f"{v:.4g}"
+            fh.write(f"| {k} | {v} |\n")
+        fh.write("\n![polar slices](slices.png)\n\n![spheres](spheres.png)\n")
+    return {"index": index, "slices": slices, "spheres": spheres, "json": js}

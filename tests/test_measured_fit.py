@@ -1,0 +1,205 @@
+"""Fitting: synthetic data from known parameters is recovered; bounds, fixed values, metrics, weights."""
+
+from __future__ import annotations
+
+import json
+import numpy as np
+import pytest
+
+import brdfkit as bk
+from brdfkit import registry
+from brdfkit.measured import fit as F
+from brdfkit.models.base import BRDF
+from brdfkit.params import Param
+
+
+class _GGXSchlickLambert(BRDF):
+    """Test-only reference: kd/π + F_Schlick(f0) · D_GGX(α) · G1(wi) G1(wo) / (4 cosθi cosθo)."""
+
+    name = "test-ggx"
+    spec = (
+        Param("kd", "rgb", 0.5, (0.0, 1.0)),
+        Param("f0", "rgb", 0.04, (0.0, 1.0)),
+        Param("alpha", "scalar", 0.3, (0.001, 1.0), log_scale=True),
+        Param("mode", "choice", "a", choices=("a", "b")),
+    )
+
+    def _eval(self, wi, wo, p):
+        a2 = p["alpha"] ** 2
+        h = wi + wo
+        h = h / np.linalg.norm(h, axis=-1, keepdims=True)
+        nh = h[..., 2:3]
+        D = a2 / (np.pi * (nh * nh * (a2 - 1) + 1) ** 2)
+
+        def g1(w):
+            c = w[..., 2:3]
+            t2 = (1 - c * c) / (c * c)
+            return 2 / (1 + np.sqrt(1 + a2 * t2))
+
+        hi = np.sum(h * wi, axis=-1, keepdims=True)
+        Fr = p["f0"] + (1 - p["f0"]) * (1 - hi) ** 5
+        return p["kd"] / np.pi + Fr * D * g1(wi) * g1(wo) / (4 * wi[..., 2:3] * wo[..., 2:3])
+
+
+TRUE = dict(kd=[0.05, 0.20, 0.45], f0=[0.9, 0.6, 0.3], alpha=0.12)
+
+
+@pytest.mark.parametrize("metric", ["ngan", "cbrt"])
+def test_recovers_known_ggx_schlick_lambert(metric):
+    truth = _GGXSchlickLambert(**TRUE)
+    r = F.fit(_GGXSchlickLambert, truth, metric=metric, samples=2000, starts=3, seed=1)
+    assert r.params["alpha"] == pytest.approx(TRUE["alpha"], rel=0.03)
+    np.testing.assert_allclose(r.params["kd"], TRUE["kd"], rtol=0.05)
+    np.testing.assert_allclose(r.params["f0"], TRUE["f0"], rtol=0.05)
+    assert r.params["mode"] == "a"  # choices stay at their default
+    assert r.error < 1e-3
+    assert r.error == pytest.approx(F.error(r.model, F.sample(truth, n=2000, seed=1), metric), rel=1e-9)
+
+
+def test_fixed_parameters_are_held_and_json_has_every_parameter():
+    truth = _GGXSchlickLambert(**TRUE)
+    r = F.fit(_GGXSchlickLambert, truth, fixed={"alpha": 0.2, "mode": "b"}, samples=1500, starts=2)
+    assert r.params["alpha"] == 0.2 and r.params["mode"] == "b"
+    js = r.to_json()
+    assert set(js["params"]) == {"kd", "f0", "alpha", "mode"}
+    assert js["metric"] == "ngan" and js["error"] > 1e-3  # the wrong alpha cannot fit exactly
+    with pytest.raises(ValueError, match="unknown parameter"):
+        F.fit(_GGXSchlickLambert, truth, fixed={"nope": 1})
+    with pytest.raises(ValueError, match="out of range"):
+        F.fit(_GGXSchlickLambert, truth, fixed={"alpha": 5.0})
+
+
+def test_parameters_stay_within_spec_bounds():
+    # data brighter than any allowed lambert: kd = 1.6 is outside [0, 1]
+    class Bright(BRDF):
+        name = "bright"
+        spec = ()
+
+        def _eval(self, wi, wo, p):
+            return np.full(wi.shape, 1.6 / np.pi)
+
+    r = F.fit("lambert", Bright(), samples=500, starts=2)
+    assert np.all(r.params["kd"] <= 1.0) and np.all(r.params["kd"] >= 0.999)
+
+
+@pytest.mark.parametrize("metric", F.METRICS)
+def test_every_metric_fits_lambert_exactly(metric):
+    truth = bk.model("lambert", kd=[0.3, 0.5, 0.7])
+    r = bk.fit("lambert", truth, metric=metric, samples=500, starts=2)
+    np.testing.assert_allclose(r.params["kd"], [0.3, 0.5, 0.7], rtol=1e-5)
+    assert r.error < 1e-6 and r.metric == metric
+
+
+def test_unknown_metric_and_model():
+    with pytest.raises(ValueError, match="valid metrics"):
+        bk.fit("lambert", "merl/chrome", metric="l7")
+    with pytest.raises(ValueError, match="unknown model"):
+        bk.fit("no-such-model", "merl/chrome")
+
+
+def test_sample_weights_integrate_over_direction_pairs():
+    """Weighted means estimate uniform averages over (ωi, ωo): E[cosθi] = 1/2, E[cosθi cosθo] = 1/4."""
+    s = F.sample(bk.model("lambert"), n=40000, seed=3, max_theta_deg=90)
+    w = s.w / s.w.sum()
+    assert np.sum(w * s.wi[:, 2]) == pytest.approx(0.5, rel=0.03)
+    assert np.sum(w * s.wo[:, 2]) == pytest.approx(0.5, rel=0.03)
+    assert np.sum(w * s.wi[:, 2] * s.wo[:, 2]) == pytest.approx(0.25, rel=0.04)
+    s80 = F.sample(bk.model("lambert"), n=2000, seed=3)
+    assert s80.wi[:, 2].min() > np.cos(np.radians(80)) and s80.wo[:, 2].min() > np.cos(np.radians(80))
+
+
+def test_fit_from_merl_file_uses_measured_bins(tmp_path):
+    truth = bk.model("lambert", kd=[0.1, 0.2, 0.3])
+    p = tmp_path / "l.binary"
+    bk.save_merl(truth, p)
+    s = F.sample(str(p), n=1000)
+    np.testing.assert_allclose(s.f, np.broadcast_to(np.array([0.1, 0.2, 0.3]) / np.pi, s.f.shape), rtol=1e-12)
+    r = bk.fit("lambert", str(p), samples=1000)
+    np.testing.assert_allclose(r.params["kd"], [0.1, 0.2, 0.3], rtol=1e-6)
+
+
+@pytest.mark.skipif("microfacet" not in registry.names(), reason="microfacet model not registered yet")
+def test_recovers_microfacet_ggx_schlick():
+    fixed = dict(distribution="ggx", fresnel="schlick", shadowing="smith")
+    spec = {p.name for p in registry.get("microfacet").spec}
+    truth_params = dict(fixed, alpha=0.15, f0=[0.9, 0.6, 0.3], kd=[0.05, 0.2, 0.45])
+    if "ks" in spec:
+        truth_params["ks"] = 1.0
+        fixed["ks"] = 1.0
+    truth_params = {k: v for k, v in truth_params.items() if k in spec}
+    truth = bk.model("microfacet", **truth_params)
+    r = bk.fit("microfacet", truth, fixed={k: v for k, v in fixed.items() if k in spec}, samples=2000, starts=3)
+    assert r.params["alpha"] == pytest.approx(0.15, rel=0.03)
+    np.testing.assert_allclose(r.params["kd"], truth_params["kd"], rtol=0.05)
+    np.testing.assert_allclose(r.params["f0"], truth_params["f0"], rtol=0.05)
+
+
+class _Run:
+    def __init__(self, returncode, stdout, stderr):
+        self.returncode, self.stdout, self.stderr = returncode, stdout, stderr
+
+
+@pytest.fixture
+def _cli(capsys):
+    """Run the CLI in-process (brdfkit.cli.main); the subprocess path is tested in test_measured_merl."""
+    from brdfkit.cli import main
+
+    def run(*args):
+        capsys.readouterr()
+        rc = main(list(args))
+        out = capsys.readouterr()
+        return _Run(rc, out.out, out.err)
+
+    return run
+
+
+def test_cli_fit_json_and_fixed(_cli):
+    r = _cli("fit", "merl/blue-acrylic", "--model", "lambert", "--json", "--samples", "500", "--starts", "2")
+    assert r.returncode == 0, r.stderr
+    out = json.loads(r.stdout)
+    assert set(out) >= {"params", "error", "metric"}
+    assert out["metric"] == "ngan" and len(out["params"]["kd"]) == 3 and out["error"] > 0
+    r = _cli("fit", "merl/blue-acrylic", "-m", "lambert", "-p", "kd=0.3", "--json", "--samples", "300")
+    assert json.loads(r.stdout)["params"]["kd"] == [0.3, 0.3, 0.3]
+
+
+@pytest.mark.parametrize(
+    "args, words",
+    [
+        (("fit", "merl/blue-acrylic"), "missing --model"),
+        (("fit", "merl/blue-acrylic", "-m", "nope"), "unknown model"),
+        (("fit", "merl/nothing", "-m", "lambert"), "unknown measured material"),
+        (("fit", "merl/blue-acrylic", "-m", "lambert", "--metric", "x"), "valid metrics"),
+        (("fit", "merl/blue-acrylic", "-m", "lambert", "-p", "zz=1"), "unknown parameter"),
+        (("fit", "--all-measured", "--set", "xx", "-m", "lambert"), "unknown measured set"),
+    ],
+)
+def test_cli_errors_are_one_line(_cli, args, words):
+    r = _cli(*args)
+    assert r.returncode != 0
+    assert words in r.stderr and "Traceback" not in r.stderr
+    assert len(r.stderr.strip().splitlines()) == 1
+
+
+def test_cli_report_and_small_batch(_cli, tmp_path):
+    rep = tmp_path / "rep"
+    r = _cli("fit", "nielsen/bluebook", "-m", "lambert", "--samples", "400", "--starts", "1", "--report", str(rep))
+    assert r.returncode == 0, r.stderr
+    for f in ("slices.png", "spheres.png", "fit.json", "index.md"):
+        assert (rep / f).stat().st_size > 100
+    assert (rep / "spheres.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    out = tmp_path / "batch"
+    r = _cli("fit", "--all-measured", "--set", "nielsen", "--limit", "3", "-m", "lambert",
+             "--samples", "300", "--starts", "1", "--out", str(out))
+    assert r.returncode == 0, r.stderr
+    rows = (out / "fit_errors.csv").read_text().strip().splitlines()
+    assert rows[0] == "material,lambert" and len(rows) == 4
+    assert all(float(x.split(",")[1]) > 0 for x in rows[1:])
+    assert (out / "fit_errors_sorted.png").exists() and "| material | lambert |" in (out / "fit_errors.md").read_text()
+
+
+def test_cli_list_measured(_cli):
+    r = _cli("list", "--measured", "--json")
+    assert r.returncode == 0, r.stderr
+    names = json.loads(r.stdout)
+    assert len(names) == 159 and "merl/chrome" in names and "nielsen/bluebook" in names
