@@ -1,0 +1,46 @@
+"""Time `brdfkit check`: one check per model, and `check --all` (the table) with 1 and 2 workers.
+
+    .venv/bin/python benchmarks/bench_check.py [--quick]
+
+Prints wall-clock seconds. The target is `check --all` under a minute on two cores.
+`--quick` skips the single-worker run.
+"""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import brdfkit as bk
+from brdfkit.analysis import check, stress_settings
+
+
+def main() -> None:
+    quick = "--quick" in sys.argv
+    print(f"{'model':<20} {'level':<7} {'seconds':>8} {'max albedo':>11} {'±err':>8}")
+    total = 0.0
+    for name in bk.models():
+        t = time.perf_counter()
+        r = check(bk.model(name), level="normal")
+        dt = time.perf_counter() - t
+        total += dt
+        print(f"{name:<20} {'normal':<7} {dt:8.2f} {r['max_albedo']:11.5f} {r['integration_error']:8.0e}")
+    print(f"{'(sum)':<20} {'':<7} {total:8.2f}")
+    n_checks = sum(len(stress_settings(n)) for n in bk.models())
+    exe = Path(sys.executable).with_name("brdfkit")
+    cmd = [str(exe)] if exe.exists() else [sys.executable, "-m", "brdfkit"]
+    print()
+    print(f"check --all: {n_checks} checks (defaults + stress), {os.cpu_count()} CPUs visible")
+    for jobs in ([2] if quick else [1, 2]):
+        t = time.perf_counter()
+        p = subprocess.run(cmd + ["check", "--all", "--json", "--jobs", str(jobs)], capture_output=True, text=True)
+        dt = time.perf_counter() - t
+        status = "ok" if p.returncode == 0 else f"exit {p.returncode}: {p.stderr.strip()[:80]}"
+        print(f"  --jobs {jobs}: {dt:6.1f} s wall  ({status})")
+
+
+if __name__ == "__main__":
+    main()
