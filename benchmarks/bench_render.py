@@ -7,8 +7,9 @@
 The mesh is the Utah teapot tessellated to about 100k triangles (filling
 roughly a third of the frame, the rest is background). Two lights (a point
 light and a directional one), 4× MSAA into a float32 framebuffer. For every
-material — OpenGL's fixed-function model and each registered BRDF with a GLSL
-file — two figures:
+material — OpenGL's fixed-function model, each registered BRDF with a GLSL
+file, and a measured material (``--measured``: its MERL table looked up in a 3D
+texture by ``shaders/measured.glsl``) — two figures:
 
 ``draw fps``   the GL draw alone (program, buffers and framebuffer made once;
                each frame: clear, draw, glFinish) — the shading throughput;
@@ -36,6 +37,12 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--frames", type=int, default=3)
     ap.add_argument("--subdivisions", type=int, default=40, help="teapot patch grid (40 -> ~100k triangles)")
     ap.add_argument("--models", default="", help="comma-separated registry names (default: all with GLSL)")
+    ap.add_argument(
+        "--measured",
+        default="merl/gold-metallic-paint",
+        help="comma-separated built-in measured materials, rendered through the MERL 3D-texture GLSL "
+        "(default: merl/gold-metallic-paint; '' for none)",
+    )
     ap.add_argument("--json", action="store_true")
     args = ap.parse_args(argv)
 
@@ -51,6 +58,9 @@ def main(argv: list[str] | None = None) -> int:
     for n in names:
         if glsl.has_shader(n):
             materials.append((n, bk.model(n)))
+    for n in (m for m in args.measured.split(",") if m):
+        # the table is tabulated and uploaded once, before the timed frames
+        materials.append((f"{n.split('/')[-1]} (MERL)", bk.material(n)))
     lights = [
         opengl.Light(position=(-2.5, 3.0, 3.0, 1.0), diffuse=(1, 1, 1)),
         opengl.Light(position=(1.0, 0.5, 1.0, 0.0), diffuse=(0.3, 0.3, 0.3)),

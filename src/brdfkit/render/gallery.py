@@ -11,6 +11,8 @@ Each figure is a grid of panels with a caption under every panel and a title:
 ``cook-torrance-metals``   Cook–Torrance 1982 metals (index of refraction from the normal-incidence
                            reflectance, as the paper does) and a roughness sweep
 ``ward-anisotropic``       Ward's brushed (anisotropic) highlight against the isotropic one
+``measured``               six measured MERL materials (built-in Neural-BRDF networks, tabulated
+                           to the MERL grid and looked up in a 3D texture by ``shaders/measured.glsl``)
 
 Nothing is downloaded: meshes are built in, materials are the registered models.
 """
@@ -186,6 +188,29 @@ def _ward() -> list[Panel]:
     return out
 
 
+MEASURED = (
+    "merl/gold-metallic-paint",
+    "merl/blue-metallic-paint",
+    "merl/chrome-steel",
+    "merl/red-specular-plastic",
+    "merl/alum-bronze",
+    "merl/pink-fabric",
+)
+"""The built-in measured materials of the ``measured`` figure."""
+
+
+def _measured() -> list[Panel]:
+    import brdfkit as bk
+
+    sphere = {"builtin": "sphere", "segments": 96, "rings": 48}
+    lights = [
+        Light(position=(-1.0, 1.2, 1.5, 0.0), diffuse=(1, 1, 1)),
+        Light(position=(1.5, -0.3, 1.0, 0.0), diffuse=(0.15, 0.15, 0.15)),
+    ]
+    lm = LightModel(ambient=(0.05, 0.05, 0.05))
+    return [Panel(name.split("/", 1)[1], sphere, bk.material(name), "phong", FRONT, lights, lm) for name in MEASURED]
+
+
 FIGURES: dict[str, Figure] = {
     f.name: f
     for f in (
@@ -195,6 +220,7 @@ FIGURES: dict[str, Figure] = {
         Figure("lambert-vs-oren-nayar", "Lambert vs Oren-Nayar on a matte sphere: rough surfaces look flat", 3, _lambert_vs_oren_nayar),
         Figure("cook-torrance-metals", "Cook-Torrance (1982) metals, and gold from smooth to rough", 4, _cook_torrance_metals),
         Figure("ward-anisotropic", "Ward's anisotropic (brushed) highlight vs the isotropic one", 3, _ward),
+        Figure("measured", "Measured materials (MERL, as Neural-BRDF networks): the table as a 3D texture in GLSL", 6, _measured),
     )
 }
 

@@ -31,6 +31,21 @@ Functions
 :func:`glslang_validate`    validate with the Khronos reference compiler
                             ``glslangValidator`` (Debian package ``glslang-tools``)
 :func:`parity_vectors`      the deterministic direction pairs the parity tests use
+:func:`table_texels`        a measured model's table as the texels of ``measured.glsl``
+
+Measured models
+---------------
+Every measured model (a MERL table from :func:`brdfkit.load_merl`, a built-in
+Neural-BRDF material from :func:`brdfkit.material`) shares
+``shaders/measured.glsl``: ``brdf()`` computes the Rusinkiewicz angles as
+:func:`brdfkit.measured.merl.symmetric_half_diff` does and reads the MERL
+table from the 3D texture ``uniform highp sampler3D u_table`` (RGBA32F,
+180 × 90 × 90 texels, NEAREST, ``texelFetch`` at the bin indices): MERL's
+nearest lookup, or trilinear over the measured corners when a MERL model's
+``interpolation`` is ``"trilinear"`` (``u_interpolation`` = 1). A Neural-BRDF
+material is tabulated at the MERL bin centres first, so the GLSL shows its
+MERL-grid version. :class:`TableTextures` uploads a table once per context
+and binds it to texture unit 0; :func:`eval_glsl` and the renderer do that.
 
 Accuracy
 --------
@@ -103,9 +118,23 @@ def _model_class(model_or_name: Any) -> type:
     raise ValueError(f"expected a model name, a model or a model class, got {model_or_name!r}")
 
 
+def is_measured(model_or_name: Any) -> bool:
+    """Whether a model (instance or class) is a measured one (:class:`brdfkit.measured.MeasuredBRDF`)."""
+    from ..measured.merl import MeasuredBRDF
+
+    if isinstance(model_or_name, type):
+        return issubclass(model_or_name, MeasuredBRDF)
+    return isinstance(model_or_name, MeasuredBRDF)
+
+
 def shader_path(model_or_name: Any) -> Path:
-    """``render/shaders/<module>.glsl`` for a model (name, instance or class); may not exist."""
+    """``render/shaders/<module>.glsl`` for a model (name, instance or class); may not exist.
+
+    Every measured model (MERL table, Neural-BRDF material) shares ``measured.glsl``.
+    """
     cls = _model_class(model_or_name)
+    if is_measured(cls):
+        return SHADER_DIR / "measured.glsl"
     module = cls.__module__.rsplit(".", 1)[-1]
     return SHADER_DIR / f"{module}.glsl"
 
@@ -198,6 +227,114 @@ def uniform_values(model: Any) -> dict[str, Any]:
 
 
 # ---------------------------------------------------------------------------
+# measured models: the MERL table as a 3D texture
+# ---------------------------------------------------------------------------
+TABLE_UNIFORM = "u_table"
+TABLE_TEXTURE_UNIT = 0
+_TABLE_CACHE_SIZE = 4  # textures kept per GL context (about 23 MB each)
+
+
+def table_key(model: Any) -> str:
+    """A key identifying a measured model's table: the material for a Neural-BRDF
+    material, a digest of the table for a MERL table (computed once per instance)."""
+    key = getattr(model, "_bk_table_key", None)
+    if key is None:
+        from ..measured.merl import MERLBRDF
+
+        if isinstance(model, MERLBRDF):
+            import hashlib
+
+            key = "merl:" + hashlib.blake2b(np.ascontiguousarray(model.table).tobytes(), digest_size=16).hexdigest()
+        elif hasattr(model, "material"):
+            key = f"{type(model).__name__}:{model.material}"
+        else:
+            key = f"{type(model).__name__}:{id(model)}"
+        try:
+            object.__setattr__(model, "_bk_table_key", key)
+        except AttributeError:  # pragma: no cover - a model without a __dict__
+            pass
+    return key
+
+
+@lru_cache(maxsize=2)
+def _texels_cached(key: str, model_ref: Any) -> np.ndarray:
+    from ..measured.merl import tabulate
+
+    t = tabulate(model_ref.model)  # (3, 90, 90, 180), negative = missing
+    out = np.empty(t.shape[1:] + (4,), dtype=np.float32)
+    out[..., :3] = np.moveaxis(np.maximum(t, 0.0), 0, -1)
+    out[..., 3] = (t >= 0).all(axis=0)
+    out.setflags(write=False)
+    return out
+
+
+class _Ref:
+    """Carries the model into the lru_cache without making it part of the key."""
+
+    def __init__(self, model: Any) -> None:
+        self.model = model
+
+    def __hash__(self) -> int:
+        return 0
+
+    def __eq__(self, other: object) -> bool:
+        return isinstance(other, _Ref)
+
+
+def table_texels(model: Any) -> np.ndarray:
+    """A measured model's table as the texels of ``measured.glsl``'s ``u_table``.
+
+    float32, shape ``(90, 90, 180, 4)`` = [θh][θd][φd][rgba] (OpenGL's depth,
+    height, width, components): rgb = the bin's value clamped at 0 per channel
+    (f_r in 1/sr), alpha = 1 where every channel was measured, else 0. A MERL
+    table is used as it is; any other measured model (a Neural-BRDF material)
+    is tabulated at the MERL bin centres first (:func:`brdfkit.measured.tabulate`,
+    about 2 s; the last two are cached).
+    """
+    if not is_measured(model):
+        raise ValueError(f"table_texels: expected a measured model, got {model!r}")
+    return _texels_cached(table_key(model), _Ref(model))
+
+
+class TableTextures:
+    """The 3D textures of measured tables uploaded to one moderngl context (a small LRU)."""
+
+    def __init__(self, ctx: Any, size: int = _TABLE_CACHE_SIZE) -> None:
+        self.ctx = ctx
+        self.size = size
+        self._tex: dict[str, Any] = {}
+
+    def get(self, model: Any):
+        key = table_key(model)
+        tex = self._tex.pop(key, None)
+        if tex is None:
+            import moderngl
+
+            data = table_texels(model)
+            th, td, pd, _ = data.shape
+            tex = self.ctx.texture3d((pd, td, th), 4, data.tobytes(), dtype="f4")
+            tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
+            tex.repeat_x = tex.repeat_y = tex.repeat_z = False
+            while len(self._tex) >= self.size:
+                old = next(iter(self._tex))
+                self._tex.pop(old).release()
+        self._tex[key] = tex  # most recently used last
+        return tex
+
+    def bind(self, prog: Any, model: Any, location: int = TABLE_TEXTURE_UNIT) -> None:
+        """Upload (once) and bind ``model``'s table to texture unit ``location`` for ``prog``."""
+        self.get(model).use(location=location)
+        u = prog.get(TABLE_UNIFORM, None)
+        if u is not None:
+            u.value = location
+
+    def release(self) -> None:
+        for tex in self._tex.values():
+            tex.release()
+        self._tex.clear()
+
+
+# ---------------------------------------------------------------------------
 # the GL context and programs
 # ---------------------------------------------------------------------------
 class _GL:
@@ -229,6 +366,7 @@ class _GL:
         self.buf_wi = ctx.buffer(reserve=_CHUNK * 12)
         self.buf_wo = ctx.buffer(reserve=_CHUNK * 12)
         self.buf_f = ctx.buffer(reserve=_CHUNK * 12)
+        self.tables = TableTextures(ctx)
 
     def program(self, key: str, vertex: str, fragment: str | None, varyings: tuple[str, ...]):
         prog = self.programs.get(key)
@@ -390,6 +528,8 @@ def eval_glsl(model: Any, wi, wo, version: str = "330 core", source: str | None 
     with _EGLCurrent(), gl.ctx:
         prog = _eval_program(src, version)
         _set_uniforms(prog, values)
+        if is_measured(model):
+            gl.tables.bind(prog, model)
         key = id(prog)
         vao = gl.vaos.get(key)
         if vao is None:
@@ -588,4 +728,8 @@ __all__ = [
     "glslang_validate",
     "gl_info",
     "parity_vectors",
+    "is_measured",
+    "table_key",
+    "table_texels",
+    "TableTextures",
 ]

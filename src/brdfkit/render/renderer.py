@@ -30,6 +30,13 @@ Backends
            but independent of the GLSL, and usable for a model without a
            GLSL file.
 ``auto``   ``glsl`` when the material has GLSL, else ``numpy``.
+
+Measured materials (a MERL table, a built-in Neural-BRDF material) have GLSL
+too: ``shaders/measured.glsl`` looks the MERL table up in a 3D texture
+(uploaded once per material and kept in a small cache; a Neural-BRDF material
+is first tabulated at the MERL bin centres, about 2 s). Their ``numpy``
+backend evaluates the model itself (for a Neural-BRDF material: the network,
+not the table).
 """
 
 from __future__ import annotations
@@ -138,6 +145,7 @@ class Renderer:
             )
         self.ctx = ctx
         self._programs: dict[str, Any] = {}
+        self._tables: Any = None  # measured tables as 3D textures (glsl.TableTextures), made on first use
 
     @property
     def info(self) -> dict[str, str]:
@@ -255,6 +263,10 @@ class Renderer:
                 u = prog.get(name, None)
                 if u is not None:
                     u.value = value
+            if glsl.is_measured(m):
+                if self._tables is None:
+                    self._tables = glsl.TableTextures(self.ctx)
+                self._tables.bind(prog, m)
             self._set(prog, "bkr_ambient_albedo", ambient_albedo(m))
 
     # ------------------------------------------------------------------ drawing

@@ -25,7 +25,9 @@ Every field is optional: the defaults are the teapot, the default camera
 directional light from the upper left (:data:`DEFAULT_LIGHTS`), OpenGL's
 light model, gold, Phong shading, an opaque black background, antialiasing.
 Relative mesh and MERL paths are resolved against the scene file's folder.
-Measured materials have no GLSL: they render through the numpy backend.
+Measured materials render through the GLSL backend too: their MERL table is
+a 3D texture (``shaders/measured.glsl``; a Neural-BRDF material is tabulated
+at the MERL bin centres first).
 """
 
 from __future__ import annotations
