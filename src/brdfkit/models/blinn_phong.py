@@ -54,12 +54,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..params import Param, kd_param, ks_param
 from ..registry import register
 from .base import BRDF
-
-#: floor on cos θi in the unnormalized form (keeps 1/(n·l) finite at grazing light)
-NL_FLOOR = 1e-4
+from .phong import NL_FLOOR, phong_family_spec  # NL_FLOOR: the same floor on cos θi
 
 
 def _n_dot_h(wi, wo):
@@ -83,27 +80,11 @@ class BlinnPhong(BRDF):
         "Akenine-Möller, Haines, Hoffman, Real-Time Rendering 3rd ed. (2008) §7.6"
     )
     isotropic = True
-    spec = (
-        kd_param(0.5),
-        ks_param(0.3, "specular weight"),
-        Param(
-            "shininess",
-            "scalar",
-            32.0,
-            (0.0, 1e5),
-            "",
-            "exponent s of (n·h)^s",
-            fit_range=(1.0, 1e4),
-            log_scale=True,
-        ),
-        Param(
-            "normalized",
-            "bool",
-            True,
-            doc="true: (s+8)/(8π)·(n·h)^s (reciprocal; lobe albedo ≤ 1.0752); "
-            "false: OpenGL's (n·h)^s divided by cos θi (neither reciprocal nor energy conserving)",
-            fit=False,
-        ),
+    spec = phong_family_spec(
+        ks_doc="specular weight",
+        shininess_doc="exponent s of (n·h)^s",
+        normalized_doc="true: (s+8)/(8π)·(n·h)^s (reciprocal; lobe albedo ≤ 1.0752); "
+        "false: OpenGL's (n·h)^s divided by cos θi (neither reciprocal nor energy conserving)",
     )
 
     def _eval(self, wi, wo, p):

@@ -59,6 +59,25 @@ from .base import BRDF
 NL_FLOOR = 1e-4
 
 
+def phong_family_spec(ks_doc: str, shininess_doc: str, normalized_doc: str) -> tuple[Param, ...]:
+    """The parameters shared by ``phong`` and ``blinn-phong``: kd, ks, shininess, normalized."""
+    return (
+        kd_param(0.5),
+        ks_param(0.3, ks_doc),
+        Param(
+            "shininess",
+            "scalar",
+            32.0,
+            (0.0, 1e5),
+            "",
+            shininess_doc,
+            fit_range=(1.0, 1e4),
+            log_scale=True,
+        ),
+        Param("normalized", "bool", True, doc=normalized_doc, fit=False),
+    )
+
+
 def _cos_power(x, s):
     """``max(0, x)^s`` with 0 (not 1) where ``x <= 0``, also for ``s = 0``."""
     pos = x > 0
@@ -74,27 +93,11 @@ class Phong(BRDF):
         "Lewis, Making shaders more physically plausible, CGF 13(2), 1994"
     )
     isotropic = True
-    spec = (
-        kd_param(0.5),
-        ks_param(0.3, "specular weight (normalized: the lobe's albedo at normal incidence)"),
-        Param(
-            "shininess",
-            "scalar",
-            32.0,
-            (0.0, 1e5),
-            "",
-            "Phong exponent s of (r·wo)^s",
-            fit_range=(1.0, 1e4),
-            log_scale=True,
-        ),
-        Param(
-            "normalized",
-            "bool",
-            True,
-            doc="true: Lewis 1994 (s+2)/(2π) lobe (reciprocal, energy conserving); "
-            "false: the lighting-equation term divided by cos θi (neither)",
-            fit=False,
-        ),
+    spec = phong_family_spec(
+        ks_doc="specular weight (normalized: the lobe's albedo at normal incidence)",
+        shininess_doc="Phong exponent s of (r·wo)^s",
+        normalized_doc="true: Lewis 1994 (s+2)/(2π) lobe (reciprocal, energy conserving); "
+        "false: the lighting-equation term divided by cos θi (neither)",
     )
 
     def _eval(self, wi, wo, p):

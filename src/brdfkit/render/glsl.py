@@ -88,6 +88,8 @@ from typing import Any
 
 import numpy as np
 
+from .context import EGLCurrent as _EGLCurrent, create_context
+
 SHADER_DIR = Path(__file__).resolve().with_name("shaders")
 
 GLSL_TYPES = {"scalar": "float", "rgb": "vec3", "bool": "int", "choice": "int", "int": "int"}
@@ -344,29 +346,18 @@ class _GL:
         import moderngl
 
         self.moderngl = moderngl
-        errors = []
-        ctx = None
-        for kwargs in ({"backend": "egl"}, {}):
-            try:
-                ctx = moderngl.create_standalone_context(require=330, **kwargs)
-                break
-            except Exception as e:  # pragma: no cover - depends on the machine
-                errors.append(f"{kwargs or 'default'}: {str(e).splitlines()[0] if str(e) else e!r}")
-        if ctx is None:  # pragma: no cover
-            raise RuntimeError(
-                "no headless OpenGL 3.3 context (install Mesa EGL: libegl1 libegl-mesa0 libgl1-mesa-dri); "
-                + "; ".join(errors)
-            )
+        ctx = create_context()
         self.ctx = ctx
-        # a draw call needs a complete framebuffer, even with rasterisation off
-        self.fbo = ctx.simple_framebuffer((1, 1))
-        self.fbo.use()
         self.programs: dict[str, Any] = {}
         self.vaos: dict[str, Any] = {}
-        self.buf_wi = ctx.buffer(reserve=_CHUNK * 12)
-        self.buf_wo = ctx.buffer(reserve=_CHUNK * 12)
-        self.buf_f = ctx.buffer(reserve=_CHUNK * 12)
-        self.tables = TableTextures(ctx)
+        with _EGLCurrent(), ctx:  # create our objects in our own context
+            # a draw call needs a complete framebuffer, even with rasterisation off
+            self.fbo = ctx.simple_framebuffer((1, 1))
+            self.fbo.use()
+            self.buf_wi = ctx.buffer(reserve=_CHUNK * 12)
+            self.buf_wo = ctx.buffer(reserve=_CHUNK * 12)
+            self.buf_f = ctx.buffer(reserve=_CHUNK * 12)
+            self.tables = TableTextures(ctx)
 
     def program(self, key: str, vertex: str, fragment: str | None, varyings: tuple[str, ...]):
         prog = self.programs.get(key)
@@ -382,58 +373,11 @@ class _GL:
 _STATE: _GL | None = None
 
 
-class _EGLCurrent:
-    """Save the calling thread's current EGL context on entry and make it current again on exit.
-
-    moderngl/glcontext's EGL backend makes a context current on creation and on
-    ``with ctx:`` but does not restore the previous one afterwards. Another
-    moderngl context in the process (the renderer's) that relies on staying
-    current would then silently issue its GL calls into ours, so every use of
-    our context is wrapped in this guard. Without libEGL it does nothing.
-    """
-
-    _lib: Any = None
-    _tried = False
-
-    @classmethod
-    def _egl(cls):
-        if not cls._tried:
-            cls._tried = True
-            try:
-                import ctypes
-
-                lib = ctypes.CDLL("libEGL.so.1")
-                for fn in ("eglGetCurrentContext", "eglGetCurrentDisplay", "eglGetCurrentSurface"):
-                    getattr(lib, fn).restype = ctypes.c_void_p
-                lib.eglGetCurrentSurface.argtypes = [ctypes.c_int]
-                lib.eglMakeCurrent.argtypes = [ctypes.c_void_p] * 4
-                lib.eglMakeCurrent.restype = ctypes.c_uint
-                cls._lib = lib
-            except (OSError, AttributeError):  # pragma: no cover - no EGL on this machine
-                cls._lib = None
-        return cls._lib
-
-    def __enter__(self):
-        lib = self._egl()
-        self.saved = None
-        if lib is not None:
-            ctx = lib.eglGetCurrentContext()
-            if ctx:
-                self.saved = (lib.eglGetCurrentDisplay(), lib.eglGetCurrentSurface(0x3059),
-                              lib.eglGetCurrentSurface(0x305A), ctx)  # EGL_DRAW, EGL_READ
-        return self
-
-    def __exit__(self, *exc):
-        if self.saved is not None:
-            self._lib.eglMakeCurrent(*self.saved)
-        return False
-
 
 def _gl() -> _GL:
     global _STATE
     if _STATE is None:
-        with _EGLCurrent():
-            _STATE = _GL()
+        _STATE = _GL()
     return _STATE
 
 

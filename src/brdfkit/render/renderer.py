@@ -51,7 +51,7 @@ import numpy as np
 from .. import opengl
 from ..opengl import Light, LightModel
 from .meshes import Mesh
-from .glsl import _EGLCurrent
+from .context import EGLCurrent as _EGLCurrent, create_context
 
 SHADER_DIR = Path(__file__).resolve().with_name("shaders")
 SHADINGS = ("flat", "gouraud", "phong")
@@ -128,21 +128,7 @@ class Renderer:
         import moderngl
 
         self.moderngl = moderngl
-        errors = []
-        ctx = None
-        for kwargs in ({"backend": "egl"}, {}):
-            try:
-                # creating a context makes it current; keep whatever was current before
-                with _EGLCurrent():
-                    ctx = moderngl.create_standalone_context(require=330, **kwargs)
-                break
-            except Exception as e:  # pragma: no cover - depends on the machine
-                errors.append(f"{kwargs or 'default'}: {str(e).splitlines()[0] if str(e) else e!r}")
-        if ctx is None:  # pragma: no cover
-            raise RuntimeError(
-                "no headless OpenGL 3.3 context (install Mesa EGL: libegl1 libegl-mesa0 libgl1-mesa-dri); "
-                + "; ".join(errors)
-            )
+        ctx = create_context()
         self.ctx = ctx
         self._programs: dict[str, Any] = {}
         self._tables: Any = None  # measured tables as 3D textures (glsl.TableTextures), made on first use
