@@ -2,13 +2,16 @@
 
 Core commands (``list``, ``info``, ``eval``) live here; each area adds its own
 commands through a ``register(app)`` function in the module listed in
-``_PLUGINS``. :func:`main` turns every ``ValueError`` / ``OSError`` into one
-line on stderr and a non-zero exit — never a traceback.
+``_PLUGINS``. :func:`main` turns every error (usage errors, ``ValueError`` /
+``OSError`` for bad input, and anything unexpected) into one line on stderr and
+a non-zero exit — never a traceback (``BRDFKIT_DEBUG=1`` shows the traceback of
+an unexpected error).
 """
 
 from __future__ import annotations
 
 import importlib
+import os
 import sys
 
 import typer
@@ -32,6 +35,10 @@ def _root() -> None:
 # Modules that add commands: each defines ``register(app: typer.Typer) -> None``.
 _PLUGINS: tuple[str, ...] = (
     "brdfkit.cli_core",
+    "brdfkit.analysis.commands",
+    "brdfkit.measured.commands",
+    "brdfkit.render.commands",
+    "brdfkit.web.commands",
 )
 
 for _mod in _PLUGINS:
@@ -47,21 +54,58 @@ def _one_line(exc: BaseException) -> str:
     return msg[0] if msg else type(exc).__name__
 
 
-def main(argv: list[str] | None = None) -> int:
-    """Entry point of the console script.
+def _usage_hint(exc: BaseException) -> str:
+    ctx = getattr(exc, "ctx", None)
+    path = getattr(ctx, "command_path", None) or "brdfkit"
+    return f" (see '{path} --help')"
 
-    typer's standalone mode handles usage errors (exit 2, a short message);
-    errors raised by brdfkit itself become one line on stderr and exit 2.
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of the console script; returns the exit status.
+
+    Every error becomes ONE line on stderr, ``brdfkit: error: ...``, and a
+    non-zero status — never a traceback: usage errors from the option parser
+    (unknown option, missing argument: status 2) as well as the ``ValueError``
+    / ``OSError`` raised by brdfkit itself for bad values or files (status 2).
+    ``--help`` and ``typer.Exit(code)`` keep their status. Any other exception
+    (a bug, a missing GL driver) is one line too, ``brdfkit: internal error: ...``,
+    status 1; set ``BRDFKIT_DEBUG=1`` to get the traceback instead.
     """
     try:
-        app(args=argv, prog_name="brdfkit", standalone_mode=True)
+        rv = app(args=argv, prog_name="brdfkit", standalone_mode=False)
     except SystemExit as e:
         code = e.code
         return code if isinstance(code, int) else (0 if code is None else 1)
     except (ValueError, OSError, CLIError, KeyError) as e:
         typer.echo(f"brdfkit: error: {_one_line(e)}", err=True)
         return 2
-    return 0
+    except typer.Abort:
+        typer.echo("brdfkit: aborted", err=True)
+        return 1
+    except Exception as e:
+        # click/typer usage errors (ClickException and subclasses): duck-typed, since
+        # their class lives in click or in typer's vendored copy depending on the version.
+        fmt = getattr(e, "format_message", None)
+        code = getattr(e, "exit_code", None)
+        if type(e).__name__ == "NoArgsIsHelpError":  # bare `brdfkit` / group: show the help
+            ctx = getattr(e, "ctx", None)
+            typer.echo(ctx.get_help() if ctx is not None else fmt())
+            return 0
+        if callable(fmt) and isinstance(code, int):
+            msg = _one_line(Exception(fmt()))
+            typer.echo(f"brdfkit: error: {msg}{_usage_hint(e)}", err=True)
+            return code or 1
+        if os.environ.get("BRDFKIT_DEBUG"):
+            raise
+        # anything else is a bug or an environment problem (no GL driver...): still one line
+        typer.echo(
+            f"brdfkit: internal error: {type(e).__name__}: {_one_line(e)} (set BRDFKIT_DEBUG=1 for the traceback)",
+            err=True,
+        )
+        return 1
+    # Without standalone mode, typer returns an explicit Exit's code (an int) or the
+    # command's return value (None for every brdfkit command).
+    return rv if isinstance(rv, int) and not isinstance(rv, bool) else 0
 
 
 def run() -> None:

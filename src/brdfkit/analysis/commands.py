@@ -10,25 +10,14 @@ import typer
 
 
 def _model(name: str, items: list[str]):
-    try:
-        from brdfkit.cli_common import model_from_cli
-    except ImportError:  # pragma: no cover - cli_common is part of the package
-        import brdfkit as bk
-        from brdfkit.params import parse_assignments
-        from brdfkit.registry import get
+    from brdfkit.cli_common import model_from_cli
 
-        return bk.model(name, **parse_assignments(name, get(name).spec, items))
     return model_from_cli(name, items)
 
 
 def _echo_json(obj: Any) -> None:
-    try:
-        from brdfkit.cli_common import print_json
-    except ImportError:  # pragma: no cover
-        import json
+    from brdfkit.cli_common import print_json
 
-        typer.echo(json.dumps(obj, indent=2))
-        return
     print_json(obj)
 
 

@@ -135,7 +135,7 @@ def check(
     else:
         furnace = f"fails: reflects {mx:.4f} > 1 ({where} {mx_theta:g}°), creating {100 * (mx - 1):.1f}% energy"
     out: dict[str, Any] = {
-        "model": getattr(model, "name", type(model).__name__),
+        "model": getattr(model, "label", None) or getattr(model, "name", type(model).__name__),
         "params": model.params_json() if hasattr(model, "params_json") else dict(getattr(model, "params", {})),
         "reciprocal": bool(rec["reciprocal"]),
         "reciprocity_error": float(rec["error"]),
