@@ -41,7 +41,7 @@ from typing import Any
 
 import numpy as np
 
-from ..geometry import from_rusinkiewicz, to_rusinkiewicz
+from ..geometry import from_rusinkiewicz
 from ..models.base import BRDF
 from ..params import Param
 
@@ -139,7 +139,9 @@ class MeasuredBRDF(BRDF):
     measured = True
 
     def _eval(self, wi, wo, p):
-        th, _ph, td, pd = to_rusinkiewicz(wi, wo)
+        # φd folded into [0, π) by reciprocity, as MERL stores it; the symmetric
+        # computation gives (wi, wo) and (wo, wi) bit-identical angles.
+        th, td, pd = symmetric_half_diff(wi, wo)
         return self.eval_rusinkiewicz(th, td, pd)
 
     def eval_rusinkiewicz(self, theta_h, theta_d, phi_d) -> np.ndarray:  # pragma: no cover
@@ -188,10 +190,6 @@ class MERLBRDF(MeasuredBRDF):
 
     def __repr__(self) -> str:
         return f"<MERLBRDF {self.label!r} interpolation={self.params['interpolation']!r}>"
-
-    def _eval(self, wi, wo, p):
-        th, td, pd = symmetric_half_diff(wi, wo)
-        return self.eval_rusinkiewicz(th, td, pd)
 
     # -- lookup ------------------------------------------------------------------
     def lookup_nearest(self, theta_h, theta_d, phi_d) -> np.ndarray:

@@ -27,7 +27,7 @@ import os
 
 import numpy as np
 
-from .merl import MeasuredBRDF
+from .merl import MeasuredBRDF, fold_phi_d
 
 _DATA = os.path.join(os.path.dirname(__file__), "data", "nbrdf_weights.npz")
 SETS = ("merl", "rgl", "nielsen")
@@ -67,7 +67,16 @@ def resolve(name: str) -> str:
 
 
 class NeuralBRDF(MeasuredBRDF):
-    """One measured material as its Neural-BRDF network (a model with no parameters)."""
+    """One measured material as its Neural-BRDF network (a model with no parameters).
+
+    The network is evaluated with φd folded into [0, π), the domain MERL stores
+    (reciprocity maps φd to φd + π). The raw networks are not exactly reciprocal:
+    over random angles the halves φd and φd + π differ by a median 3 % for the
+    MERL networks and 30 % for the RGL ones (measured), so evaluating the raw
+    network on [0, 2π) would make a measured material fail the reciprocity law
+    for reasons of the fit, not of the material. Folding makes ``eval`` exactly
+    reciprocal and equal to the MERL table that :func:`save_merl` writes.
+    """
 
     name = "nbrdf"
     title = "measured material (Neural-BRDF network of Sztrajman et al. 2021)"
@@ -93,7 +102,7 @@ class NeuralBRDF(MeasuredBRDF):
             np.asarray(theta_h, np.float64), np.asarray(theta_d, np.float64), np.asarray(phi_d, np.float64)
         )
         shape = th.shape
-        th, td, pd = th.ravel(), td.ravel(), pd.ravel()
+        th, td, pd = th.ravel(), td.ravel(), fold_phi_d(pd.ravel())
         sd = np.sin(td)
         x = np.empty((th.size, 6), dtype=np.float32)
         x[:, 0] = np.sin(th)
