@@ -316,12 +316,9 @@ float bk_atan2_pos(float y, float x) {
 
 #define BK_FLT_MAX 3.402823466e+38
 
-// log(1 + x) for x in [-0.5, 0.5] without cancellation: 2 atanh(z), z = x/(2 + x),
-// |z| <= 1/3, series to z^19 (truncation < 1e-10 relative); plain log elsewhere.
-float bk_log1p(float x) {
-    if (abs(x) > 0.5) return log(1.0 + x);
-    float z = x / (2.0 + x);
-    float z2 = z * z;
+// The tail of the atanh series: (atanh(z) − z)/z³ = 1/3 + z²/5 + … + z¹⁶/19 for |z| <= 1/3
+// (truncation < 1e-10 relative), as a polynomial in z2 = z².
+float bk_atanh_tail(float z2) {
     float p = 1.0 / 19.0;
     p = p * z2 + 1.0 / 17.0;
     p = p * z2 + 1.0 / 15.0;
@@ -331,8 +328,16 @@ float bk_log1p(float x) {
     p = p * z2 + 1.0 / 7.0;
     p = p * z2 + 1.0 / 5.0;
     p = p * z2 + 1.0 / 3.0;
-    p = p * z2 + 1.0;
-    return 2.0 * z * p;
+    return p;
+}
+
+// log(1 + x) for x in [-0.5, 0.5] without cancellation: 2 atanh(z), z = x/(2 + x),
+// |z| <= 1/3; plain log elsewhere.
+float bk_log1p(float x) {
+    if (abs(x) > 0.5) return log(1.0 + x);
+    float z = x / (2.0 + x);
+    float z2 = z * z;
+    return 2.0 * z * (1.0 + z2 * bk_atanh_tail(z2));
 }
 
 // Natural log accurate near 1: GL implementations compute log/log2 with an
