@@ -168,3 +168,21 @@ def test_bad_angles_rejected():
         albedo(bk.model("lambert"), float("nan"))
     with pytest.raises(ValueError, match="over"):
         albedo(bk.model("lambert"), 0.1, over="x")
+
+
+def test_albedo_adds_the_mirror_delta_of_htsg_and_schlick():
+    """eval cannot return a Dirac delta: the albedo adds delta_reflectance(w) exactly once."""
+    import brdfkit as bk
+    from brdfkit.analysis import albedo
+
+    th = np.radians([0.0, 40.0, 80.0])
+    w = np.stack([np.sin(th), np.zeros_like(th), np.cos(th)], axis=-1)
+    htsg = bk.model("htsg", sigma0=0.05)  # smooth enough for a strong coherent part
+    schlick = bk.model("schlick", color=1.0, r=0.3)
+    for m, delta in ((htsg, htsg.specular_reflectance(w)), (schlick, schlick.mirror_reflectance(w))):
+        with_delta = albedo(m, th, level="fast")
+        without = albedo(m, th, level="fast", include_delta=False)
+        assert np.max(delta) > 0.05
+        np.testing.assert_allclose(with_delta - without, delta, rtol=1e-12, atol=1e-15)
+    lam = bk.model("lambert", kd=0.7)
+    np.testing.assert_array_equal(albedo(lam, th, level="fast"), albedo(lam, th, level="fast", include_delta=False))

@@ -267,6 +267,7 @@ def albedo_result(
     level: str = DEFAULT_LEVEL,
     charts: tuple[str, ...] = ("H", "R", "D"),
     max_nodes: int = 100_000,
+    include_delta: bool = True,
 ) -> AlbedoResult:
     """Albedo with error estimate; see :func:`albedo`."""
     if over not in ("wi", "wo"):
@@ -338,6 +339,10 @@ def albedo_result(
         best = np.argmin(errs, axis=0)
     value = fine[best, idx]
     err = errs[best, idx]
+    if include_delta and hasattr(model, "delta_reflectance"):
+        # the ideal-mirror part maps θ to θ (and is reciprocal): the same term for over="wi" and "wo"
+        w = np.stack([np.sin(flat) * math.cos(phi_o), np.sin(flat) * math.sin(phi_o), np.cos(flat)], axis=-1)
+        value = value + np.asarray(model.delta_reflectance(w), dtype=np.float64)
     err = np.maximum(err, 1e-13 * np.max(np.abs(value), axis=-1))
     chart = np.asarray(charts)[best]
     return AlbedoResult(
@@ -353,6 +358,7 @@ def albedo(
     over: str = "wi",
     level: str = DEFAULT_LEVEL,
     return_error: bool = False,
+    include_delta: bool = True,
 ):
     """Directional albedo of ``model`` at polar angles ``theta_o`` (radians, in [0, π/2)).
 
@@ -364,9 +370,11 @@ def albedo(
     Returns an array of shape ``theta_o.shape + (3,)`` (RGB); with
     ``return_error=True`` also the error estimate (difference between two
     quadrature resolutions, largest over channels), shape ``theta_o.shape``.
-    ``level`` is ``"fast"``, ``"normal"`` or ``"fine"``.
+    ``level`` is ``"fast"``, ``"normal"`` or ``"fine"``. With ``include_delta`` (default)
+    the model's ideal-mirror part (:meth:`BRDF.delta_reflectance`: HTSG's coherent
+    specular, Schlick's mirror) is added, since ``eval`` cannot return a delta.
     """
-    res = albedo_result(model, theta_o, phi_o, over=over, level=level)
+    res = albedo_result(model, theta_o, phi_o, over=over, level=level, include_delta=include_delta)
     if return_error:
         return res.value, res.error
     return res.value

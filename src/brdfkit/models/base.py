@@ -73,6 +73,16 @@ class BRDF:
     def _eval(self, wi: np.ndarray, wo: np.ndarray, p: dict[str, Any]) -> np.ndarray:  # pragma: no cover
         raise NotImplementedError
 
+    def delta_reflectance(self, w) -> np.ndarray:
+        """Reflectance of the model's ideal-mirror (Dirac) part for light from ``w``, shape ``(..., 3)``.
+
+        That light leaves along ``reflect(w)``; ``eval`` cannot return a delta, so
+        albedo and energy checks add this term. Zero for models without one (all
+        but ``htsg`` and ``schlick``).
+        """
+        w = np.asarray(w)
+        return np.zeros(w.shape[:-1] + (3,), dtype=np.float32 if w.dtype == np.float32 else np.float64)
+
     # -- conveniences ------------------------------------------------------------
     def eval_angles(self, theta_i, phi_i, theta_o, phi_o) -> np.ndarray:
         """``eval`` from spherical angles in radians."""

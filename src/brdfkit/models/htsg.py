@@ -497,6 +497,10 @@ class HTSG(BRDF):
         F = fresnel_conductor(cos_local[..., None], self._eta, self._k)
         return F * geo * k2 * (np.pi * self._tau / (2.0 * lam)) ** 2 * ratio
 
+    def delta_reflectance(self, w) -> np.ndarray:
+        """The coherent mirror part (see :meth:`specular_reflectance`), for albedo and energy checks."""
+        return self.specular_reflectance(w)
+
     def specular_reflectance(self, wi) -> np.ndarray:
         """Fraction of the incident power in the coherent mirror reflection: ``|F(θi)|² e^(−g) S(θi)²``.
 

@@ -208,6 +208,10 @@ class Schlick(BRDF):
             f = f + (dt(1) - S) * S2 * D2
         return f
 
+    def delta_reflectance(self, w) -> np.ndarray:
+        """The ideal-mirror part (see :meth:`mirror_reflectance`), for albedo and energy checks."""
+        return self.mirror_reflectance(w)
+
     def mirror_reflectance(self, wi) -> np.ndarray:
         """RGB weight of the ideal-mirror (Dirac) part for light from ``wi``, sent into reflect(wi).
 
