@@ -10,14 +10,13 @@ from __future__ import annotations
 from typing import Any
 
 from . import geometry, params, registry
-from .models.base import BRDF
-
-__version__ = "0.1.0"
-
 
 # ``models`` is the package brdfkit.models, made callable: ``bk.models()`` lists the
 # registry names (SPEC) and ``import brdfkit.models.ward`` still works.
-from . import models  # noqa: E402
+from . import models
+from .models.base import BRDF
+
+__version__ = "0.1.0"
 
 
 def model_info(name: str) -> dict[str, Any]:
