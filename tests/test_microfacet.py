@@ -319,3 +319,29 @@ def test_beckmann_matches_mitsuba_roughconductor(mi, ax, ay):
                     fresnel="conductor", eta=eta, k=k).eval(wi, wo)
     np.testing.assert_allclose(ours, theirs, rtol=7e-3, atol=1e-9)
     np.testing.assert_allclose(ours, approx, rtol=7e-3, atol=1e-12)
+
+
+@pytest.mark.parametrize("fresnel", ["conductor", "dielectric", "schlick", "none"])
+def test_active_params_leave_out_exactly_what_changes_nothing(fresnel):
+    """A parameter missing from active_params() must not change eval; every rgb one kept must."""
+    import brdfkit as bk
+
+    rng = np.random.default_rng(3)
+    wi = rng.normal(size=(200, 3))
+    wo = rng.normal(size=(200, 3))
+    wi[:, 2] = np.abs(wi[:, 2]) + 0.1
+    wo[:, 2] = np.abs(wo[:, 2]) + 0.1
+    wi /= np.linalg.norm(wi, axis=1, keepdims=True)
+    wo /= np.linalg.norm(wo, axis=1, keepdims=True)
+    m = bk.model("microfacet", fresnel=fresnel, eta=1.7, k=2.0, f0=0.3)
+    base = m.eval(wi, wo)
+    active = m.active_params()
+    assert "alpha" in active and "alpha_x" not in active
+    for name, other in (("eta", 2.5), ("k", 0.5), ("f0", 0.8)):
+        changed = m.with_params(**{name: other}).eval(wi, wo)
+        if name in active:
+            assert np.max(np.abs(changed - base)) > 1e-6, name
+        else:
+            np.testing.assert_array_equal(changed, base)
+    aniso = bk.model("microfacet", alpha_x=0.1, alpha_y=0.3)
+    assert "alpha" not in aniso.active_params() and "alpha_x" in aniso.active_params()

@@ -50,8 +50,9 @@ def _fmt_value(v: Any) -> str:
 
 
 def label(model: Any, width: int | None = None) -> str:
-    """``name(k=v, ...)`` with every parameter, for legends and titles."""
-    params = getattr(model, "params", {}) or {}
+    """``name(k=v, ...)`` with every parameter in effect (:meth:`BRDF.active_params`), for legends and titles."""
+    active = getattr(model, "active_params", None)
+    params = active() if callable(active) else (getattr(model, "params", {}) or {})
     text = f"{getattr(model, 'name', type(model).__name__)}(" + ", ".join(
         f"{k}={_fmt_value(v)}" for k, v in params.items()
     ) + ")"

@@ -73,6 +73,15 @@ class BRDF:
     def _eval(self, wi: np.ndarray, wo: np.ndarray, p: dict[str, Any]) -> np.ndarray:  # pragma: no cover
         raise NotImplementedError
 
+    def active_params(self) -> dict[str, Any]:
+        """The parameters that affect this instance's values (for labels and titles).
+
+        All of them by default; a model whose options switch parameters off
+        (``microfacet``'s Fresnel choice, say) leaves those out. ``params`` stays
+        the complete, effective set.
+        """
+        return dict(self.params)
+
     def delta_reflectance(self, w) -> np.ndarray:
         """Reflectance of the model's ideal-mirror (Dirac) part for light from ``w``, shape ``(..., 3)``.
 

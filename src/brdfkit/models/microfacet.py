@@ -175,6 +175,17 @@ class Microfacet(BRDF):
         self.params["alpha"] = ax if ax == ay else None
         self.isotropic = ax == ay  # per instance; the class (info) says "can be anisotropic"
 
+    def active_params(self) -> dict[str, Any]:
+        """``params`` less what the options switch off: eta/k/f0 by Fresnel, alpha vs alpha_x/alpha_y."""
+        unused = {
+            "conductor": ("f0",),
+            "dielectric": ("k", "f0"),
+            "schlick": ("eta", "k"),
+            "none": ("eta", "k", "f0"),
+        }[self.params["fresnel"]]
+        unused += ("alpha_x", "alpha_y") if self.isotropic else ("alpha",)
+        return {k: v for k, v in self.params.items() if k not in unused}
+
     def with_params(self, **changes: Any) -> "Microfacet":
         """A copy with some parameters changed; ``alpha`` and ``alpha_x``/``alpha_y`` replace each other."""
         new = dict(self.params)
