@@ -48,14 +48,32 @@ def vector_to_spherical(v) -> tuple[np.ndarray, np.ndarray]:
     return theta, phi
 
 
-def half_vector(wi, wo) -> np.ndarray:
-    """``normalize(wi + wo)``; for ``wi == -wo`` (undefined) returns the normal ``+z``."""
+def scaled_sum(wi, wo) -> tuple[np.ndarray, np.ndarray]:
+    """``(S, m)`` with ``S = (wi + wo) / m`` and ``m`` the largest absolute component of ``wi + wo``.
+
+    ``S`` has the direction of the half vector and a length in ``[1, √3]``, so
+    normalising it neither underflows nor overflows: a pair like
+    ``(1, 0, 1e-300)``, ``(−1, 0, 1e-300)`` gives ``+z`` instead of 0/0 (the
+    naive ``normalize(wi + wo)`` fails there). Ratios of components of ``H =
+    wi + wo`` (Ward's exponent) can be taken from ``S`` directly; ``|H| =
+    m·|S|``. Where ``wi == −wo`` (``m == 0``) ``S`` is ``+z``.
+    """
     h = np.asarray(wi) + np.asarray(wo)
-    n = np.sqrt(dot(h, h))
-    z = np.zeros_like(h)
-    z[..., 2] = 1
-    safe = n > 1e-12
-    return np.where(safe[..., None], h / np.where(safe, n, 1)[..., None], z)
+    m = np.max(np.abs(h), axis=-1)
+    zero = m == 0
+    s = h / np.where(zero, 1, m)[..., None]
+    if np.any(zero):
+        s = np.where(zero[..., None], np.array([0, 0, 1], dtype=s.dtype), s)
+    return s, m
+
+
+def half_vector(wi, wo) -> np.ndarray:
+    """``normalize(wi + wo)``, robust at grazing angles (see :func:`scaled_sum`); ``+z`` where ``wi == −wo``.
+
+    Every model that needs the half vector calls this one function.
+    """
+    s, _ = scaled_sum(wi, wo)
+    return s / np.sqrt(dot(s, s))[..., None]
 
 
 def reflect(w, n=None) -> np.ndarray:
@@ -69,13 +87,15 @@ def reflect(w, n=None) -> np.ndarray:
     return 2 * dot(w, n)[..., None] * n - w
 
 
-def _rotate_z(v, a):
+def rotate_z(v, a):
+    """Rotate vectors ``v`` by angle ``a`` (radians) about +z."""
     c, s = np.cos(a), np.sin(a)
     x, y, z = v[..., 0], v[..., 1], v[..., 2]
     return np.stack([c * x - s * y, s * x + c * y, z], axis=-1)
 
 
 def _rotate_y(v, a):
+    """Rotate vectors ``v`` by angle ``a`` (radians) about +y."""
     c, s = np.cos(a), np.sin(a)
     x, y, z = v[..., 0], v[..., 1], v[..., 2]
     return np.stack([c * x + s * z, y, -s * x + c * z], axis=-1)
@@ -87,7 +107,7 @@ def to_rusinkiewicz(wi, wo):
     wo = np.asarray(wo, dtype=np.float64)
     h = half_vector(wi, wo)
     theta_h, phi_h = vector_to_spherical(h)
-    d = _rotate_y(_rotate_z(wi, -phi_h), -theta_h)
+    d = _rotate_y(rotate_z(wi, -phi_h), -theta_h)
     theta_d, phi_d = vector_to_spherical(d)
     return theta_h, phi_h, theta_d, phi_d
 
@@ -97,7 +117,7 @@ def from_rusinkiewicz(theta_h, phi_h, theta_d, phi_d):
     h = spherical_to_vector(theta_h, phi_h)
     d = spherical_to_vector(theta_d, phi_d)
     th, ph = np.broadcast_arrays(np.asarray(theta_h, float), np.asarray(phi_h, float))
-    wi = _rotate_z(_rotate_y(d, th), ph)
+    wi = rotate_z(_rotate_y(d, th), ph)
     wo = 2 * dot(wi, h)[..., None] * h - wi
     return wi, wo
 
@@ -138,7 +158,9 @@ __all__ = [
     "normalize",
     "spherical_to_vector",
     "vector_to_spherical",
+    "scaled_sum",
     "half_vector",
+    "rotate_z",
     "reflect",
     "to_rusinkiewicz",
     "from_rusinkiewicz",

@@ -266,6 +266,11 @@ def ks_param(default: Any = 0.5, doc: str = "specular weight", hi: float = 1.0) 
     return Param("ks", "rgb", default, (0.0, hi), "", doc)
 
 
+def exponent_param(name: str, default: float, doc: str) -> Param:
+    """A cosine-power exponent (Phong shininess, Ashikhmin-Shirley n_u/n_v): [0, 1e5], fitted in [1, 1e4]."""
+    return Param(name, "scalar", default, (0.0, 1e5), "", doc, fit_range=(1.0, 1e4), log_scale=True)
+
+
 __all__ = [
     "Param",
     "ParamSpec",
@@ -276,4 +281,5 @@ __all__ = [
     "spec_names",
     "kd_param",
     "ks_param",
+    "exponent_param",
 ]

@@ -63,22 +63,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..params import Param
+from ..geometry import half_vector
+from ..params import Param, exponent_param
 from ..registry import register
 from ..terms.fresnel import fresnel_schlick
 from .base import BRDF
 
 #: floor on h·k and max(n·wi, n·wo) in the specular denominator
 COS_FLOOR = 1e-6
-
-
-def _scaled_half(wi, wo):
-    """``(hx, hy, hz, |H|)`` of H = wi + wo rescaled by its largest component (safe for z = 1e-300)."""
-    H = wi + wo
-    m = np.max(np.abs(H), axis=-1)
-    Hs = H / m[..., None]
-    ln = np.sqrt(np.einsum("...i,...i->...", Hs, Hs))
-    return Hs[..., 0] / ln, Hs[..., 1] / ln, Hs[..., 2] / ln, m * ln
 
 
 def anisotropic_cos_power(hx, hy, hz, nu, nv):
@@ -102,26 +94,8 @@ class AshikhminShirley(BRDF):
     spec = (
         Param("rd", "rgb", 0.5, (0.0, 1.0), "", "diffuse reflectance R_d"),
         Param("rs", "rgb", 0.05, (0.0, 1.0), "", "specular reflectance at normal incidence R_s (Schlick F0)"),
-        Param(
-            "nu",
-            "scalar",
-            100.0,
-            (0.0, 1e5),
-            "",
-            "Phong exponent along the tangent +x (smaller = wider highlight in x)",
-            fit_range=(1.0, 1e4),
-            log_scale=True,
-        ),
-        Param(
-            "nv",
-            "scalar",
-            100.0,
-            (0.0, 1e5),
-            "",
-            "Phong exponent along the bitangent +y",
-            fit_range=(1.0, 1e4),
-            log_scale=True,
-        ),
+        exponent_param("nu", 100.0, "Phong exponent along the tangent +x (smaller = wider highlight in x)"),
+        exponent_param("nv", 100.0, "Phong exponent along the bitangent +y"),
     )
 
     def _eval(self, wi, wo, p):
@@ -129,7 +103,8 @@ class AshikhminShirley(BRDF):
         pi = dt(np.pi)
         rd, rs = p["rd"], p["rs"]
         nu, nv = p["nu"], p["nv"]
-        hx, hy, hz, _ = _scaled_half(wi, wo)
+        h = half_vector(wi, wo)
+        hx, hy, hz = h[..., 0], h[..., 1], h[..., 2]
         hk = np.clip(np.einsum("...i,...i->...", wi, np.stack([hx, hy, hz], axis=-1)), dt(0), dt(1))
         ci, co = wi[..., 2], wo[..., 2]
         lobe = anisotropic_cos_power(hx, hy, hz, nu, nv)

@@ -54,21 +54,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..geometry import half_vector
 from ..registry import register
 from .base import BRDF
-from .phong import NL_FLOOR, phong_family_spec  # NL_FLOOR: the same floor on cos θi
-
-
-def _n_dot_h(wi, wo):
-    """``n·normalize(wi + wo)`` for directions above the horizon, robust to under/overflow.
-
-    The sum is rescaled by its largest component before normalising, so two
-    grazing directions with z = 1e-300 still give a well-defined cosine.
-    """
-    H = wi + wo
-    m = np.max(np.abs(H), axis=-1)  # > 0: H.z = wi.z + wo.z > 0
-    H = H / m[..., None]
-    return H[..., 2] / np.sqrt(np.einsum("...i,...i->...", H, H))
+from .phong import phong_family_combine, phong_family_spec
 
 
 @register
@@ -89,11 +78,6 @@ class BlinnPhong(BRDF):
 
     def _eval(self, wi, wo, p):
         dt = wi.dtype.type
-        nh = np.clip(_n_dot_h(wi, wo), dt(0), dt(1))
+        nh = np.clip(half_vector(wi, wo)[..., 2], dt(0), dt(1))
         s = p["shininess"]
-        lobe = np.power(nh, s)
-        if p["normalized"]:
-            lobe = lobe * ((s + dt(8)) / dt(8 * np.pi))
-        else:
-            lobe = lobe / np.maximum(wi[..., 2], dt(NL_FLOOR))
-        return p["kd"] / dt(np.pi) + p["ks"] * lobe[..., None]
+        return phong_family_combine(np.power(nh, s), wi, p, (s + dt(8)) / dt(8 * np.pi))

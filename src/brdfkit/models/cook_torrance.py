@@ -45,13 +45,13 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..geometry import half_vector
 from ..params import Param, kd_param, ks_param
 from ..registry import register
 from ..terms.distributions import beckmann
 from ..terms.fresnel import fresnel_dielectric_cook
 from ..terms.shadowing import v_groove
 from .base import BRDF
-from .microfacet import half_vector_above
 
 _COS_FLOOR = {np.dtype(np.float32): 1e-18, np.dtype(np.float64): 1e-150}
 
@@ -74,7 +74,7 @@ class CookTorrance(BRDF):
     def _eval(self, wi, wo, p):
         dt = wi.dtype
         floor = dt.type(_COS_FLOOR[dt])
-        h = half_vector_above(wi, wo)
+        h = half_vector(wi, wo)
         n_l = wi[..., 2]
         n_v = wo[..., 2]
         n_h = h[..., 2]

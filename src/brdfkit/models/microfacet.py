@@ -69,6 +69,7 @@ from typing import Any
 
 import numpy as np
 
+from ..geometry import half_vector
 from ..params import Param, kd_param, ks_param
 from ..registry import register
 from ..terms.distributions import distribution as _distribution
@@ -115,17 +116,6 @@ def resolve_roughness(model: str, given: dict[str, Any], by_name: dict[str, Para
                     )
         params["alpha"] = params["alpha_x"] = params["alpha_y"] = a
     return params
-
-
-def half_vector_above(wi: np.ndarray, wo: np.ndarray) -> np.ndarray:
-    """``normalize(wi + wo)`` for directions above the horizon, robust to under/overflow.
-
-    The sum is first scaled by its largest component (its z is > 0), so that a
-    pair like ``(1, 0, 1e-300)``, ``(−1, 0, 1e-300)`` gives ``+z`` instead of 0/0.
-    """
-    h = wi + wo
-    h = h / np.max(np.abs(h), axis=-1, keepdims=True)
-    return h / np.sqrt(np.einsum("...i,...i->...", h, h))[..., None]
 
 
 def fresnel_term(kind: str, c: np.ndarray, p: dict[str, Any], dtype) -> np.ndarray:
@@ -204,7 +194,7 @@ class Microfacet(BRDF):
         d_fn, lam_fn = _distribution(p["distribution"])
         ax, ay = p["alpha_x"], p["alpha_y"]
 
-        h = half_vector_above(wi, wo)  # h_z > 0 since both directions are above the horizon
+        h = half_vector(wi, wo)  # h_z > 0 since both directions are above the horizon
         cos_i = wi[..., 2]
         cos_o = wo[..., 2]
         lh = np.einsum("...i,...i->...", wi, h)
@@ -229,4 +219,4 @@ class Microfacet(BRDF):
         return spec + p["kd"] / dt.type(np.pi)
 
 
-__all__ = ["Microfacet", "GOLD_ETA", "GOLD_K", "GOLD_F0", "resolve_roughness", "fresnel_term", "half_vector_above"]
+__all__ = ["Microfacet", "GOLD_ETA", "GOLD_K", "GOLD_F0", "resolve_roughness", "fresnel_term"]

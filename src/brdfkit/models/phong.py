@@ -51,7 +51,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..params import Param, kd_param, ks_param
+from ..params import Param, exponent_param, kd_param, ks_param
 from ..registry import register
 from .base import BRDF
 
@@ -64,18 +64,17 @@ def phong_family_spec(ks_doc: str, shininess_doc: str, normalized_doc: str) -> t
     return (
         kd_param(0.5),
         ks_param(0.3, ks_doc),
-        Param(
-            "shininess",
-            "scalar",
-            32.0,
-            (0.0, 1e5),
-            "",
-            shininess_doc,
-            fit_range=(1.0, 1e4),
-            log_scale=True,
-        ),
+        exponent_param("shininess", 32.0, shininess_doc),
         Param("normalized", "bool", True, doc=normalized_doc, fit=False),
     )
+
+
+def phong_family_combine(lobe, wi, p, norm):
+    """kd/π + ks·lobe in the family's two forms: ``normalized`` scales the lobe by ``norm``;
+    the raw lighting-equation form divides it by cos θi (floored at :data:`NL_FLOOR`)."""
+    dt = wi.dtype.type
+    lobe = lobe * norm if p["normalized"] else lobe / np.maximum(wi[..., 2], dt(NL_FLOOR))
+    return p["kd"] / dt(np.pi) + p["ks"] * lobe[..., None]
 
 
 def _cos_power(x, s):
@@ -106,8 +105,4 @@ class Phong(BRDF):
         rv = wi[..., 2] * wo[..., 2] - wi[..., 0] * wo[..., 0] - wi[..., 1] * wo[..., 1]
         s = p["shininess"]
         lobe = _cos_power(np.minimum(rv, dt(1)), s)
-        if p["normalized"]:
-            lobe = lobe * ((s + dt(2)) / dt(2 * np.pi))
-        else:
-            lobe = lobe / np.maximum(wi[..., 2], dt(NL_FLOOR))
-        return p["kd"] / dt(np.pi) + p["ks"] * lobe[..., None]
+        return phong_family_combine(lobe, wi, p, (s + dt(2)) / dt(2 * np.pi))

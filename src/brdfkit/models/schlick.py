@@ -118,6 +118,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..geometry import half_vector
 from ..params import Param
 from ..registry import register
 from ..terms.fresnel import fresnel_schlick
@@ -135,11 +136,7 @@ def split_weights(r: float) -> tuple[float, float, float]:
 def _half_terms(wi, wo):
     """``(t, s2, u, w2, at_n)``: n·h, 1 − (n·h)² (from hx² + hy², no cancellation), h·wi,
     w² = cos² of h's azimuth from +x, and ``h == n``."""
-    H = wi + wo
-    m = np.max(np.abs(H), axis=-1)  # > 0: H.z > 0
-    Hs = H / m[..., None]
-    ln = np.sqrt(np.einsum("...i,...i->...", Hs, Hs))
-    h = Hs / ln[..., None]
+    h = half_vector(wi, wo)
     t = h[..., 2]
     u = np.clip(np.einsum("...i,...i->...", wi, h), 0, 1)
     s2 = h[..., 0] ** 2 + h[..., 1] ** 2

@@ -89,6 +89,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..geometry import scaled_sum
 from ..params import Param, kd_param, ks_param
 from ..registry import register
 from .base import BRDF
@@ -104,9 +105,7 @@ def ward_exponent(wi, wo, ax, ay):
     free), so directions with z = 1e-300 neither underflow to 0/0 nor
     overflow. Returns ``(exponent, |H|, cos θh)``.
     """
-    H = wi + wo
-    m = np.max(np.abs(H), axis=-1)  # > 0 because H.z = wi.z + wo.z > 0
-    Hs = H / m[..., None]
+    Hs, m = scaled_sum(wi, wo)  # m > 0 because H.z = wi.z + wo.z > 0
     hx, hy, hz = Hs[..., 0], Hs[..., 1], Hs[..., 2]
     len_s = np.sqrt(hx * hx + hy * hy + hz * hz)
     num = (hx / ax) ** 2 + (hy / ay) ** 2
