@@ -16,6 +16,9 @@ Kinds
 ``bool``    ``True``/``False``
 ``int``     an integer within ``range``
 
+``unit`` is empty for dimensionless numbers (albedos, slopes, exponents,
+refractive indices); ``info`` shows them as ``1``, SI's notation.
+
 Every error is a one-line :class:`ValueError` naming the model, the parameter
 and what is allowed.
 """
@@ -74,6 +77,12 @@ class Param:
         rb = ")" if (self.open_hi or math.isinf(hi)) else "]"
         return f"{lb}{_fmt(lo)}, {_fmt(hi)}{rb}"
 
+    def unit_text(self) -> str:
+        """The unit as shown: ``"1"`` for a dimensionless number (SI's notation), ``""`` for choices and bools."""
+        if self.kind in ("choice", "bool"):
+            return ""
+        return self.unit or "1"
+
     def default_json(self) -> Any:
         d = self.default
         if isinstance(d, np.ndarray):
@@ -94,7 +103,7 @@ class Param:
             if self.range is None or self.kind in ("choice", "bool") or math.isinf(self.range[1])
             else self.range[1],
             "choices": list(self.choices) if self.kind == "choice" else None,
-            "unit": self.unit,
+            "unit": self.unit_text(),
             "doc": self.doc,
         }
 
