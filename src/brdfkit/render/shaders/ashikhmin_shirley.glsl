@@ -25,10 +25,7 @@ float ashikhmin_shirley_one_minus_pow5(float x) {
 
 vec3 brdf(vec3 wi, vec3 wo) {
     if (bk_below(wi, wo)) return vec3(0.0);
-    vec3 H = wi + wo;
-    float m = max(max(abs(H.x), abs(H.y)), abs(H.z));
-    vec3 Hs = H / m;
-    vec3 h = Hs / sqrt(dot(Hs, Hs));
+    vec3 h = bk_half_vector(wi, wo);
     float hk = clamp(dot(wi, h), 0.0, 1.0);
     float ci = wi.z;
     float co = wo.z;

@@ -12,8 +12,7 @@ uniform int u_normalized;
 
 vec3 brdf(vec3 wi, vec3 wo) {
     if (bk_below(wi, wo)) return vec3(0.0);
-    vec3 H = wi + wo;
-    H /= max(max(abs(H.x), abs(H.y)), abs(H.z));
+    vec3 H = bk_scaled_sum(wi, wo);
     // (n·h)^s = exp(s·log1p(−(1 − n·h))) with 1 − n·h = (Hx² + Hy²)/(|H|(|H| + Hz)):
     // no cancellation, so large s keeps its accuracy (n·h itself is only good to an ulp).
     float len = sqrt(dot(H, H));

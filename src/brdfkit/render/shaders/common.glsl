@@ -91,6 +91,20 @@ float bk_sqr(float x) { return x * x; }
 // the horizon test every brdf() starts with
 bool bk_below(vec3 wi, vec3 wo) { return wi.z <= 0.0 || wo.z <= 0.0; }
 
+// wi + wo divided by its largest absolute component: the half vector's direction with
+// a length in [1, √3], safe to normalise at grazing angles (brdfkit.geometry.scaled_sum).
+// Callers have wi.z + wo.z > 0, so the divisor is positive.
+vec3 bk_scaled_sum(vec3 wi, vec3 wo) {
+    vec3 H = wi + wo;
+    return H / max(max(abs(H.x), abs(H.y)), abs(H.z));
+}
+
+// normalize(wi + wo), robust at grazing angles (brdfkit.geometry.half_vector)
+vec3 bk_half_vector(vec3 wi, vec3 wo) {
+    vec3 s = bk_scaled_sum(wi, wo);
+    return s / sqrt(dot(s, s));
+}
+
 // ---------------------------------------------------------------------------
 // Fresnel (terms/fresnel.py)
 // ---------------------------------------------------------------------------

@@ -9,8 +9,7 @@ uniform vec3 u_ior;
 
 vec3 brdf(vec3 wi, vec3 wo) {
     if (bk_below(wi, wo)) return vec3(0.0);
-    vec3 h = wi + wo;
-    h = h / sqrt(dot(h, h));
+    vec3 h = bk_half_vector(wi, wo);
     float n_l = wi.z;
     float n_v = wo.z;
     float l_h = dot(wi, h);

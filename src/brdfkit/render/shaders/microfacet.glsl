@@ -26,8 +26,7 @@ vec3 brdf(vec3 wi, vec3 wo) {
     float ax = u_alpha_x;
     float ay = u_alpha_y;
     int dist = u_distribution == 1 ? BK_GGX : BK_BECKMANN;
-    vec3 h = wi + wo;
-    h = h / sqrt(dot(h, h));
+    vec3 h = bk_half_vector(wi, wo);
     float cos_i = wi.z;
     float cos_o = wo.z;
     float lh = dot(wi, h);

@@ -26,8 +26,7 @@ float schlick_slab(vec3 Hs, float w2, bool at_n, float v, float v2, float r, flo
 
 vec3 brdf(vec3 wi, vec3 wo) {
     if (bk_below(wi, wo)) return vec3(0.0);
-    vec3 H = wi + wo;
-    vec3 Hs = H / max(max(abs(H.x), abs(H.y)), abs(H.z));
+    vec3 Hs = bk_scaled_sum(wi, wo);
     vec3 h = Hs / sqrt(dot(Hs, Hs));
     float u = clamp(dot(wi, h), 0.0, 1.0);
     float s2 = h.x * h.x + h.y * h.y;

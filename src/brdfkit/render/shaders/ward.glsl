@@ -16,7 +16,7 @@ vec3 brdf(vec3 wi, vec3 wo) {
     float ax = u_alpha_x;
     float ay = u_alpha_y;
     vec3 H = wi + wo;
-    float m = max(max(abs(H.x), abs(H.y)), abs(H.z));
+    float m = max(max(abs(H.x), abs(H.y)), abs(H.z));  // |H| = m·|Hs| is needed below
     vec3 Hs = H / m;
     float len_s = sqrt(Hs.x * Hs.x + Hs.y * Hs.y + Hs.z * Hs.z);
     float num = bk_sqr(Hs.x / ax) + bk_sqr(Hs.y / ay);
