@@ -31,6 +31,7 @@ Nothing here imports brdfkit: the reference owes nothing to the code it checks.
 from __future__ import annotations
 
 import ctypes
+import dataclasses
 import json
 import os
 import sys
@@ -223,33 +224,9 @@ def call(request: dict, timeout: float = 120.0, llvm: bool = True) -> dict:
     return json.loads(proc.stdout)
 
 
-def material_json(m) -> dict:
-    return {
-        "ambient": list(m.ambient),
-        "diffuse": list(m.diffuse),
-        "specular": list(m.specular),
-        "emission": list(m.emission),
-        "shininess": m.shininess,
-    }
-
-
-def light_json(L) -> dict:
-    return {
-        "position": list(L.position),
-        "ambient": list(L.ambient),
-        "diffuse": list(L.diffuse),
-        "specular": list(L.specular),
-        "constant_attenuation": L.constant_attenuation,
-        "linear_attenuation": L.linear_attenuation,
-        "quadratic_attenuation": L.quadratic_attenuation,
-        "spot_direction": list(L.spot_direction),
-        "spot_exponent": L.spot_exponent,
-        "spot_cutoff": L.spot_cutoff,
-    }
-
-
-def light_model_json(lm) -> dict:
-    return {"ambient": list(lm.ambient), "local_viewer": bool(lm.local_viewer)}
+def as_json(obj) -> dict:
+    """A ``brdfkit.opengl`` Material, Light or LightModel as a request object (its field names)."""
+    return dataclasses.asdict(obj)
 
 
 # --------------------------------------------------------------------------- entry point (subprocess)

@@ -186,9 +186,9 @@ def _compare_with_mesa(n_cases: int, seed: int, llvm: bool) -> None:
         "mode": "shade",
         "cases": [
             {
-                "material": mesa.material_json(m),
-                "lights": [mesa.light_json(L) for L in ls],
-                "light_model": mesa.light_model_json(lm),
+                "material": mesa.as_json(m),
+                "lights": [mesa.as_json(L) for L in ls],
+                "light_model": mesa.as_json(lm),
                 "positions": P.tolist(),
                 "normals": N.tolist(),
             }

@@ -51,12 +51,15 @@ from typing import Any, Mapping, Sequence
 
 import numpy as np
 
+from ..geometry import dot, normalize
+
 __all__ = [
     "Material",
     "MATERIALS",
     "Light",
     "LightModel",
     "shade",
+    "light_vector",
     "material_from_json",
     "light_from_json",
     "light_model_from_json",
@@ -135,7 +138,11 @@ class Light:
     ``position`` is ``(x, y, z, w)``: ``w = 0`` makes a directional light shining
     *from* direction ``(x, y, z)``; ``w != 0`` a point light at ``xyz / w``
     (three numbers mean ``w = 1``, a point light).
-    ``spot_cutoff`` is in degrees: 180 (no spot) or [0, 90].
+    Colours are linear RGBA, usually in [0, 1] (not enforced; OpenGL clamps the sum).
+    Attenuation coefficients are >= 0: ``constant`` (unitless), ``linear`` (per
+    eye-space unit), ``quadratic`` (per unit²); they apply to point lights only.
+    ``spot_direction`` is an eye-space vector (normalised when used);
+    ``spot_exponent`` is in [0, 128]; ``spot_cutoff`` is in degrees: 180 (no spot) or [0, 90].
     """
 
     position: Any = (0.0, 0.0, 1.0, 0.0)
@@ -228,9 +235,28 @@ MATERIALS: dict[str, Material] = _parse_table(_TABLE)
 
 
 # --------------------------------------------------------------------------- shading
-def _normalize(v: np.ndarray) -> np.ndarray:
-    n = np.sqrt(np.einsum("...i,...i->...", v, v))
-    return v / np.where(n > 0, n, 1.0)[..., None]
+def light_vector(L: Light, P: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Unit vectors ``VP`` from eye-space points ``P`` (N, 3) toward light ``L``, and ``att × spot`` (N,).
+
+    The attenuation and spotlight factors of the module docstring (OpenGL 2.1
+    §2.14.1); shared by :func:`shade` and the BRDF path of
+    :mod:`brdfkit.render.lighting`.
+    """
+    pos = np.asarray(L.position, dtype=np.float64)
+    if L.is_positional:
+        to_light = pos[:3] / pos[3] - P
+        d = np.sqrt(dot(to_light, to_light))
+        vp = to_light / np.where(d > 0, d, 1.0)[:, None]
+        factor = 1.0 / (L.constant_attenuation + L.linear_attenuation * d + L.quadratic_attenuation * d * d)
+    else:
+        vp = np.broadcast_to(normalize(pos[:3]), P.shape)
+        factor = np.ones(P.shape[0])
+    if L.is_spot:
+        sd = normalize(np.asarray(L.spot_direction, dtype=np.float64))
+        cos_s = -(vp @ sd)  # −VP · ŝ
+        inside = cos_s >= math.cos(math.radians(L.spot_cutoff))
+        factor = factor * np.where(inside, np.power(np.maximum(cos_s, 0.0), L.spot_exponent), 0.0)
+    return vp, factor
 
 
 def shade(
@@ -247,9 +273,7 @@ def shade(
     (N, 4) RGBA in [0, 1] (float64). ``material`` may be a :data:`MATERIALS` name.
     """
     if isinstance(material, str):
-        if material not in MATERIALS:
-            raise ValueError(f"unknown material {material!r}; valid materials: {', '.join(MATERIALS)}")
-        material = MATERIALS[material]
+        material = material_from_json(material)
     if isinstance(lights, Light):
         lights = (lights,)
     lights = tuple(lights)
@@ -268,7 +292,7 @@ def shade(
         P = P[:, :3] / w
     if N.shape != P.shape:
         raise ValueError(f"normals must have shape {P.shape} like positions, got {N.shape}")
-    n = _normalize(N)
+    n = normalize(N)
 
     a_cm = np.array(material.ambient[:3])
     d_cm = np.array(material.diffuse[:3])
@@ -278,32 +302,17 @@ def shade(
 
     c = np.broadcast_to(e_cm + a_cm * np.array(lm.ambient[:3]), P.shape).copy()
     if lm.local_viewer:
-        ve = _normalize(-P)
+        ve = normalize(-P)
     else:
         ve = np.broadcast_to(np.array([0.0, 0.0, 1.0]), P.shape)
 
     for L in lights:
-        pos = np.array(L.position)
-        if L.is_positional:
-            vp_raw = pos[:3] / pos[3] - P
-            d = np.sqrt(np.einsum("ij,ij->i", vp_raw, vp_raw))
-            vp = vp_raw / np.where(d > 0, d, 1.0)[:, None]
-            att = 1.0 / (L.constant_attenuation + L.linear_attenuation * d + L.quadratic_attenuation * d * d)
-        else:
-            vp = np.broadcast_to(_normalize(pos[:3]), P.shape)
-            att = np.ones(P.shape[0])
-        if L.is_spot:
-            sd = _normalize(np.array(L.spot_direction))
-            cos_s = -(vp @ sd)  # P_pli V · ŝ
-            inside = cos_s >= math.cos(math.radians(L.spot_cutoff))
-            spot = np.where(inside, np.power(np.maximum(cos_s, 0.0), L.spot_exponent), 0.0)
-        else:
-            spot = np.ones(P.shape[0])
-        ndotl = np.einsum("ij,ij->i", n, vp)
+        vp, factor = light_vector(L, P)
+        ndotl = dot(n, vp)
         lit = ndotl > 0
         diff = np.maximum(ndotl, 0.0)
-        h = _normalize(vp + ve)
-        ndoth = np.maximum(np.einsum("ij,ij->i", n, h), 0.0)
+        h = normalize(vp + ve)
+        ndoth = np.maximum(dot(n, h), 0.0)
         with np.errstate(divide="ignore", invalid="ignore"):
             spec = np.where(lit, np.power(ndoth, srm), 0.0)
         term = (
@@ -311,7 +320,7 @@ def shade(
             + diff[:, None] * (np.array(L.diffuse[:3]) * d_cm)
             + spec[:, None] * (np.array(L.specular[:3]) * s_cm)
         )
-        c += (att * spot)[:, None] * term
+        c += factor[:, None] * term
 
     out = np.empty((P.shape[0], 4))
     out[:, :3] = np.clip(c, 0.0, 1.0)

@@ -87,6 +87,9 @@ def camera_matrices(spec: Mapping[str, Any] | None, aspect: float) -> tuple[np.n
         fov = float(full["fov_deg"])
     except (TypeError, ValueError):
         raise ValueError("camera eye, target, up must be 3 numbers each and fov_deg a number") from None
+    # Default clip planes (scene units) suit an object of about unit radius at the target
+    # (the unit sphere, the teapot, a mesh scaled by load_mesh): near halfway to its front
+    # (at dist - 1), far well past its back (at dist + 1). Give near/far for other scenes.
     dist = float(np.linalg.norm(eye - target))
     near = float(full.get("near", max(1e-3, dist - 2.0) * 0.5))
     far = float(full.get("far", dist + 4.0))

@@ -64,19 +64,10 @@ def register(app: typer.Typer) -> None:
 
         from ..cli_common import model_from_cli
         from . import scene as sc
+        from .image import IMAGE_SUFFIXES
 
-        if scene is not None:
-            if not scene.is_file():
-                raise OSError(f"scene file not found: {scene}")
-            try:
-                obj: dict[str, Any] = json.loads(scene.read_text(encoding="utf-8"))
-            except json.JSONDecodeError as e:
-                raise ValueError(f"scene file {scene} is not valid JSON: {e.msg} (line {e.lineno})") from None
-            if not isinstance(obj, dict):
-                raise ValueError("a scene must be a JSON object")
-            base = scene.parent
-        else:
-            obj, base = {}, None
+        obj: dict[str, Any] = sc.read_scene_file(scene) if scene is not None else {}
+        base = scene.parent if scene is not None else None
         if sum(x is not None for x in (model, opengl_material, measured)) > 1:
             raise ValueError("give only one of --model, --opengl, --measured")
         if param and model is None:
@@ -121,9 +112,8 @@ def register(app: typer.Typer) -> None:
             obj["srgb"] = srgb
         if material is not None:
             obj["material"] = material  # an object: scene_from_json takes it as it is
-        suffix = output.suffix.lower()
-        if suffix not in (".png", ".exr", ".npy"):
-            raise ValueError(f"output must end in .png, .exr or .npy; got {str(output)!r}")
+        if output.suffix.lower() not in IMAGE_SUFFIXES:  # fail before rendering, as save_image would after
+            raise ValueError(f"output must end in {', '.join(IMAGE_SUFFIXES)}; got {str(output)!r}")
         # the look: the material's defaults, then the scene file's fields, then the flags (already in obj)
         parsed, look = sc.scene_from_json(obj, base_dir=base)
         t0 = time.perf_counter()

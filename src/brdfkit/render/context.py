@@ -58,6 +58,12 @@ class EGLCurrent:
         return False
 
 
+def context_info(ctx: Any) -> dict[str, str]:
+    """Vendor, renderer and version strings of a moderngl context (make it current first)."""
+    info = ctx.info
+    return {k: str(info.get(k)) for k in ("GL_VENDOR", "GL_RENDERER", "GL_VERSION")}
+
+
 def create_context(require: int = 330) -> Any:
     """A standalone moderngl context of at least GL ``require`` (EGL first)."""
     import moderngl

@@ -27,7 +27,9 @@ from typing import Any, Callable, Sequence
 import numpy as np
 
 from .. import opengl
+from ..geometry import normalize, reflect
 from ..opengl import Light, LightModel
+from .camera import DEFAULT_CAMERA, look_at
 
 # --------------------------------------------------------------------------- panels
 
@@ -53,7 +55,7 @@ class Figure:
 
 
 FRONT = {"eye": [0.0, 0.0, 3.6], "target": [0.0, 0.0, 0.0], "up": [0.0, 1.0, 0.0], "fov_deg": 36.0}
-ABOVE = {"eye": [0.0, 1.0, 3.45], "target": [0.0, 0.0, 0.0], "up": [0.0, 1.0, 0.0], "fov_deg": 36.0}
+ABOVE = DEFAULT_CAMERA  # slightly above the equator
 TEAPOT_CAM = {"eye": [0.0, 1.1, 3.4], "target": [0.0, -0.05, 0.0], "up": [0.0, 1.0, 0.0], "fov_deg": 33.0}
 
 GL_LIGHT = [Light(position=(-1.0, 1.0, 1.0, 0.0), diffuse=(1, 1, 1), specular=(1, 1, 1))]
@@ -68,11 +70,9 @@ STUDIO_AMBIENT = LightModel(ambient=(0.08, 0.08, 0.08))
 
 def world_light(direction, camera: dict, **kw) -> Light:
     """A directional light shining from world ``direction``, expressed in the camera's eye space."""
-    from .camera import look_at
-
     mv = look_at(camera["eye"], camera.get("target", (0, 0, 0)), camera.get("up", (0, 1, 0)))
-    d = mv[:3, :3] @ np.asarray(direction, dtype=np.float64)
-    return Light(position=tuple(d / np.linalg.norm(d)) + (0.0,), **kw)
+    d = normalize(mv[:3, :3] @ np.asarray(direction, dtype=np.float64))
+    return Light(position=tuple(d) + (0.0,), **kw)
 
 
 def _materials() -> list[Panel]:
@@ -86,7 +86,7 @@ def _highlight_light(theta_deg: float, phi_deg: float) -> Light:
     """A directional light whose highlight (infinite viewer, n = h) sits at the sphere point (θ from +y, φ)."""
     t, p = math.radians(theta_deg), math.radians(phi_deg)
     n = np.array([math.sin(t) * math.sin(p), math.cos(t), math.sin(t) * math.cos(p)])
-    l = 2 * n[2] * n - np.array([0.0, 0.0, 1.0])  # the mirror of the view direction (0, 0, 1)
+    l = reflect(np.array([0.0, 0.0, 1.0]), n)  # the mirror of the view direction (0, 0, 1)
     return Light(position=tuple(l) + (0.0,), diffuse=(1, 1, 1), specular=(1, 1, 1))
 
 
@@ -303,9 +303,16 @@ def compose(title: str, images: list[np.ndarray], captions: list[str], columns: 
     return canvas
 
 
-def render_figure(fig: Figure, size: int = 256, advance: Callable[[], None] | None = None, mesh_cache=None):
+def render_figure(
+    fig: Figure,
+    size: int = 256,
+    advance: Callable[[], None] | None = None,
+    mesh_cache=None,
+    panels: list[Panel] | None = None,
+):
+    """The figure as a labelled PIL image; ``panels`` defaults to ``fig.panels()`` (pass them if already built)."""
     mesh_cache = {} if mesh_cache is None else mesh_cache
-    panels = fig.panels()
+    panels = fig.panels() if panels is None else panels
     images = []
     for p in panels:
         images.append(render_panel(p, size, mesh_cache))
@@ -322,7 +329,7 @@ def run_gallery(out_dir: str | Path, names: Sequence[str] | None = None, size: i
     out.mkdir(parents=True, exist_ok=True)
     names = list(names) if names else list(FIGURES)
     figs = [FIGURES[n] for n in names]
-    counts = [len(f.panels()) for f in figs]
+    panel_lists = [f.panels() for f in figs]  # built once: measured panels load networks
     written: list[Path] = []
     mesh_cache: dict = {}
     with Progress(
@@ -333,10 +340,10 @@ def run_gallery(out_dir: str | Path, names: Sequence[str] | None = None, size: i
         disable=not progress,
         transient=False,
     ) as bar:
-        task = bar.add_task("gallery", total=sum(counts))
-        for fig in figs:
+        task = bar.add_task("gallery", total=sum(len(p) for p in panel_lists))
+        for fig, panels in zip(figs, panel_lists):
             bar.update(task, description=fig.name)
-            img = render_figure(fig, size, lambda: bar.advance(task), mesh_cache)
+            img = render_figure(fig, size, lambda: bar.advance(task), mesh_cache, panels)
             path = out / f"{fig.name}.png"
             img.save(path, optimize=True)
             written.append(path)

@@ -88,7 +88,8 @@ from typing import Any
 
 import numpy as np
 
-from .context import EGLCurrent as _EGLCurrent, create_context
+from ..geometry import normalize, random_unit_vectors, reflect, spherical_to_vector
+from .context import EGLCurrent as _EGLCurrent, context_info, create_context
 
 SHADER_DIR = Path(__file__).resolve().with_name("shaders")
 
@@ -155,9 +156,14 @@ def _read_file(path: Path) -> str:
     return _read(path, path.stat().st_mtime_ns)
 
 
+def shader_file(name: str) -> str:
+    """The text of ``shaders/<name>``, read from disk only when the file changed."""
+    return _read_file(SHADER_DIR / name)
+
+
 def common_source() -> str:
     """The text of ``shaders/common.glsl``."""
-    return _read_file(SHADER_DIR / "common.glsl")
+    return shader_file("common.glsl")
 
 
 def shader_source(model_or_name: Any) -> str:
@@ -373,7 +379,6 @@ class _GL:
 _STATE: _GL | None = None
 
 
-
 def _gl() -> _GL:
     global _STATE
     if _STATE is None:
@@ -385,8 +390,7 @@ def gl_info() -> dict[str, str]:
     """Vendor, renderer and version of the GL context :func:`eval_glsl` uses."""
     gl = _gl()
     with _EGLCurrent(), gl.ctx:
-        info = gl.ctx.info
-    return {k: str(info.get(k)) for k in ("GL_VENDOR", "GL_RENDERER", "GL_VERSION")}
+        return context_info(gl.ctx)
 
 
 def _header(version: str) -> str:
@@ -428,7 +432,8 @@ def _eval_program(source: str, version: str):
     return gl.program("eval:" + vertex, vertex, fragment, ("bk_out_f",))
 
 
-def _set_uniforms(prog, values: dict[str, Any]) -> None:
+def set_uniforms(prog, values: dict[str, Any]) -> None:
+    """Set ``{name: value}`` (as from :func:`uniform_values`) on a moderngl program, skipping absent ones."""
     for name, value in values.items():
         u = prog.get(name, None)
         if u is None:  # declared but unused: optimised away by the compiler
@@ -471,7 +476,7 @@ def eval_glsl(model: Any, wi, wo, version: str = "330 core", source: str | None 
     # current for the duration and give theirs back afterwards
     with _EGLCurrent(), gl.ctx:
         prog = _eval_program(src, version)
-        _set_uniforms(prog, values)
+        set_uniforms(prog, values)
         if is_measured(model):
             gl.tables.bind(prog, model)
         key = id(prog)
@@ -550,26 +555,15 @@ def glslang_validate(model_or_name: Any, version: str = "300 es") -> None:
 # ---------------------------------------------------------------------------
 # shared test vectors
 # ---------------------------------------------------------------------------
-def _unit(v: np.ndarray) -> np.ndarray:
-    return v / np.linalg.norm(v, axis=-1, keepdims=True)
-
-
 def _sph(theta_deg, phi_deg) -> np.ndarray:
-    t = np.radians(np.asarray(theta_deg, dtype=np.float64))
-    p = np.radians(np.asarray(phi_deg, dtype=np.float64))
-    return np.stack(np.broadcast_arrays(np.sin(t) * np.cos(p), np.sin(t) * np.sin(p), np.cos(t)), axis=-1)
+    """Unit vectors from polar angle and azimuth in degrees."""
+    return spherical_to_vector(np.radians(theta_deg), np.radians(phi_deg))
 
 
 def _grazing(z: float, phi_deg) -> np.ndarray:
     p = np.radians(np.asarray(phi_deg, dtype=np.float64))
     r = np.sqrt(1.0 - z * z)
     return np.stack(np.broadcast_arrays(r * np.cos(p), r * np.sin(p), np.full_like(p, z)), axis=-1)
-
-
-def _mirror(w: np.ndarray) -> np.ndarray:
-    out = -w.copy()
-    out[..., 2] = w[..., 2]
-    return out
 
 
 @lru_cache(maxsize=None)
@@ -584,11 +578,7 @@ def _parity_vectors(n_random: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         kinds.extend([kind] * wi.shape[0])
 
     def hemi(n):
-        u = rng.random((n, 2))
-        z = u[:, 0]
-        r = np.sqrt(1.0 - z * z)
-        phi = 2 * np.pi * u[:, 1]
-        return np.stack([r * np.cos(phi), r * np.sin(phi), z], axis=-1)
+        return random_unit_vectors(n, rng)
 
     z = np.array([0.0, 0.0, 1.0])
     # uniform random pairs over the upper hemisphere
@@ -596,9 +586,9 @@ def _parity_vectors(n_random: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     # pairs near the mirror direction (specular peaks), cones of 1°..15° around it
     wo = hemi(n_random // 2)
     jitter = rng.normal(size=wo.shape) * np.radians(rng.choice([1.0, 5.0, 15.0], size=(wo.shape[0], 1)))
-    wi = _unit(_mirror(wo) + jitter)
+    wi = normalize(reflect(wo) + jitter)
     wi[:, 2] = np.abs(wi[:, 2]) + 1e-3
-    add("near-mirror", _unit(wi), wo)
+    add("near-mirror", normalize(wi), wo)
     # normal incidence and viewing
     add("normal", z, z)
     add("normal-wi", z, _sph([20, 45, 70, 89], [0, 90, 200, 300]))
@@ -608,19 +598,19 @@ def _parity_vectors(n_random: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     add("wi==wo", w, w)
     # exact mirror pairs
     w = _sph([1, 10, 30, 45, 60, 75, 85, 89], [0, 30, 60, 90, 120, 180, 270, 315])
-    add("mirror", _mirror(w), w)
+    add("mirror", reflect(w), w)
     # near-grazing: z = 1e-3 for wi, wo, both (same side, mirror, perpendicular)
     g = _grazing(1e-3, [0, 60, 90, 180])
     add("grazing-wi", g, _sph([0, 30, 60, 85], [20, 80, 300, 180]))
     add("grazing-wo", _sph([0, 30, 60, 85], [200, 100, 10, 45]), g)
     add("grazing-both", g, g)
-    add("grazing-both", _mirror(g), g)
+    add("grazing-both", reflect(g), g)
     add("grazing-both", _grazing(1e-3, [90, 150, 0, 270]), g)
     # a hair above the horizon (z = cos 90° in float64, 6e-17)
     h = _sph([90, 90], [0, 45])
     add("grazing-6e-17", h, _sph([30, 60], [0, 90]))
     add("grazing-6e-17", _sph([30, 60], [0, 90]), h)
-    add("grazing-6e-17", h, _mirror(h))
+    add("grazing-6e-17", h, reflect(h))
     # exactly at and below the horizon: the result must be 0
     h[:, 2] = 0.0
     add("horizon", h, _sph([30, 60], [0, 90]))
@@ -664,6 +654,7 @@ __all__ = [
     "uniform_declarations",
     "declared_uniforms",
     "uniform_values",
+    "set_uniforms",
     "eval_glsl",
     "compile_source",
     "compile_check",

@@ -32,48 +32,26 @@ direction ``w`` becomes ``(w·t, w·b, w·n)`` — SPEC.md's local frame.
 
 from __future__ import annotations
 
-import math
 from typing import Any, Sequence
 
 import numpy as np
 
 from .. import opengl
-from ..opengl import Light, LightModel
+from ..geometry import dot, normalize, to_local
+from ..opengl import Light, LightModel, light_vector
 
-
-def _unit(v: np.ndarray) -> np.ndarray:
-    n = np.linalg.norm(v, axis=-1, keepdims=True)
-    return v / np.where(n > 0, n, 1.0)
-
-
-def light_vector(L: Light, P: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Unit vectors from points ``P`` (N, 3) toward light ``L`` and the factor attenuation × spot (N,)."""
-    pos = np.asarray(L.position, dtype=np.float64)
-    if L.is_positional:
-        d = pos[:3] / pos[3] - P
-        dist = np.linalg.norm(d, axis=-1)
-        vp = d / np.where(dist > 0, dist, 1.0)[:, None]
-        factor = 1.0 / (L.constant_attenuation + L.linear_attenuation * dist + L.quadratic_attenuation * dist * dist)
-    else:
-        vp = np.broadcast_to(_unit(pos[:3]), P.shape)
-        factor = np.ones(P.shape[0])
-    if L.is_spot:
-        sd = _unit(np.asarray(L.spot_direction, dtype=np.float64))
-        cs = -(vp @ sd)
-        inside = cs >= math.cos(math.radians(L.spot_cutoff))
-        factor = factor * np.where(inside, np.power(np.maximum(cs, 0.0), L.spot_exponent), 0.0)
-    return vp, factor
+__all__ = ["light_vector", "orthonormal_tangent", "ambient_albedo", "brdf_shade", "shade_points"]
 
 
 def orthonormal_tangent(n: np.ndarray, t: np.ndarray) -> np.ndarray:
     """``t`` made orthogonal to the unit normals ``n``; any perpendicular where ``t ∥ n``."""
-    u = t - n * np.einsum("ij,ij->i", n, t)[:, None]
+    u = t - n * dot(n, t)[:, None]
     length = np.linalg.norm(u, axis=-1)
     weak = length <= 1e-6
     if weak.any():
         a = np.where((np.abs(n[weak, 0]) < 0.9)[:, None], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0])
-        u[weak] = a - n[weak] * np.einsum("ij,ij->i", n[weak], a)[:, None]
-    return _unit(u)
+        u[weak] = a - n[weak] * dot(n[weak], a)[:, None]
+    return normalize(u)
 
 
 def ambient_albedo(model: Any, n: int = 64) -> np.ndarray:
@@ -111,20 +89,17 @@ def brdf_shade(
 ) -> np.ndarray:
     """Radiance (N, 3) reflected toward the eye (at the origin) by a BRDF material at eye-space points ``P``."""
     P = np.asarray(P, dtype=np.float64)
-    n = _unit(np.asarray(n, dtype=np.float64))
+    n = normalize(np.asarray(n, dtype=np.float64))
     t = orthonormal_tangent(n, np.asarray(t, dtype=np.float64))
     b = np.cross(n, t)
-    v = _unit(-P)
-    local = lambda w: np.stack(  # noqa: E731
-        [np.einsum("ij,ij->i", w, t), np.einsum("ij,ij->i", w, b), np.einsum("ij,ij->i", w, n)], axis=-1
-    )
-    wo = local(v)
+    v = normalize(-P)
+    wo = to_local(v, t, b, n)
     ambient = np.broadcast_to(np.asarray(light_model.ambient[:3]), P.shape).copy()
     c = np.zeros(P.shape)
     for L in lights:
         vp, factor = light_vector(L, P)
         ambient += factor[:, None] * np.asarray(L.ambient[:3])
-        wi = local(np.ascontiguousarray(vp))
+        wi = to_local(vp, t, b, n)
         ok = (wi[:, 2] > 0) & (wo[:, 2] > 0) & (factor > 0)
         if ok.any():
             f = model.eval(wi[ok], wo[ok])

@@ -10,7 +10,8 @@ tangent generated from their normals: ``normalize(ŷ × n)`` (``x̂ × n`` where
 the normal is parallel to ŷ).
 
 All built-in meshes are centred at the origin, y up, and fit in the unit
-sphere.
+sphere (the plane excepted: a square of half-size ``half_size``). Lengths are
+in scene units.
 """
 
 from __future__ import annotations
@@ -20,6 +21,8 @@ from dataclasses import dataclass
 from typing import Any, Mapping
 
 import numpy as np
+
+from .. import geometry
 
 BUILTIN = ("sphere", "torus", "teapot", "plane")
 
@@ -36,8 +39,8 @@ class Mesh:
 
     def __post_init__(self) -> None:
         self.positions = np.ascontiguousarray(self.positions, dtype=np.float32)
-        self.normals = np.ascontiguousarray(_unit(np.asarray(self.normals, dtype=np.float64)), dtype=np.float32)
-        self.tangents = np.ascontiguousarray(_unit(np.asarray(self.tangents, dtype=np.float64)), dtype=np.float32)
+        self.normals = np.ascontiguousarray(geometry.normalize(np.asarray(self.normals, dtype=np.float64)), dtype=np.float32)
+        self.tangents = np.ascontiguousarray(geometry.normalize(np.asarray(self.tangents, dtype=np.float64)), dtype=np.float32)
         self.faces = np.ascontiguousarray(self.faces, dtype=np.int32)
         v = len(self.positions)
         if self.positions.ndim != 2 or self.positions.shape[1] != 3:
@@ -58,9 +61,13 @@ class Mesh:
         return int(len(self.positions))
 
 
-def _unit(v: np.ndarray) -> np.ndarray:
-    n = np.linalg.norm(v, axis=-1, keepdims=True)
-    return v / np.where(n > 0, n, 1.0)
+def _fit_unit_sphere(P: np.ndarray) -> np.ndarray:
+    """Points moved so that their bounding box is centred at the origin, then scaled so that
+    the farthest is at distance 1 (left unscaled if they all coincide)."""
+    lo, hi = P.min(0), P.max(0)
+    P = P - (lo + hi) / 2
+    r = np.linalg.norm(P, axis=1).max()
+    return P / (r if r > 0 else 1.0)
 
 
 def _grid_faces(rows: int, cols: int, offset: int = 0) -> np.ndarray:
@@ -175,9 +182,7 @@ def teapot(subdivisions: int = 12) -> Mesh:
     # z-up -> y-up: (x, y, z) -> (x, z, -y) (a rotation, keeps handedness)
     rot = lambda a: np.stack([a[:, 0], a[:, 2], -a[:, 1]], axis=-1)  # noqa: E731
     P, N, T = rot(P), rot(N), rot(T)
-    lo, hi = P.min(0), P.max(0)
-    P = P - (lo + hi) / 2
-    P = P / np.linalg.norm(P, axis=1).max()
+    P = _fit_unit_sphere(P)
     # orient the winding like the normals
     e = np.cross(P[F[:, 1]] - P[F[:, 0]], P[F[:, 2]] - P[F[:, 0]])
     flip = np.einsum("ij,ij->i", e, N[F].sum(axis=1)) < 0
@@ -188,12 +193,12 @@ def teapot(subdivisions: int = 12) -> Mesh:
 
 def generated_tangents(normals: np.ndarray) -> np.ndarray:
     """Tangents circling the y axis: ``normalize(ŷ × n)``, or ``x̂ × n`` where n ∥ ŷ."""
-    n = _unit(np.asarray(normals, dtype=np.float64))
+    n = geometry.normalize(np.asarray(normals, dtype=np.float64))
     t = np.cross(np.array([0.0, 1.0, 0.0]), n)
     weak = np.linalg.norm(t, axis=1) < 1e-3
     if weak.any():
         t[weak] = np.cross(np.array([1.0, 0.0, 0.0]), n[weak])
-    return _unit(t)
+    return geometry.normalize(t)
 
 
 def load_mesh(path: str | os.PathLike, normalize: bool = True) -> Mesh:
@@ -216,10 +221,7 @@ def load_mesh(path: str | os.PathLike, normalize: bool = True) -> Mesh:
     P = np.asarray(tm.vertices, dtype=np.float64)
     N = np.asarray(tm.vertex_normals, dtype=np.float64)
     if normalize:
-        lo, hi = P.min(0), P.max(0)
-        P = P - (lo + hi) / 2
-        r = np.linalg.norm(P, axis=1).max()
-        P = P / (r if r > 0 else 1.0)
+        P = _fit_unit_sphere(P)
     return Mesh(P, N, generated_tangents(N), np.asarray(tm.faces), name=os.path.basename(path))
 
 

@@ -43,17 +43,16 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any, Sequence
 
 import numpy as np
 
 from .. import opengl
+from ..geometry import normalize
 from ..opengl import Light, LightModel
 from .meshes import Mesh
-from .context import EGLCurrent as _EGLCurrent, create_context
+from .context import EGLCurrent as _EGLCurrent, context_info, create_context
 
-SHADER_DIR = Path(__file__).resolve().with_name("shaders")
 SHADINGS = ("flat", "gouraud", "phong")
 BACKENDS = ("auto", "glsl", "numpy")
 MSAA_SAMPLES = 4
@@ -99,7 +98,10 @@ class Scene:
 
 
 def _read_shader(name: str) -> str:
-    return (SHADER_DIR / name).read_text(encoding="utf-8")
+    """A pipeline shader's text; cached (re-read only when the file changes), as this runs per frame."""
+    from .glsl import shader_file
+
+    return shader_file(name)
 
 
 def _normal_matrix(mv: np.ndarray) -> np.ndarray:
@@ -135,8 +137,7 @@ class Renderer:
 
     @property
     def info(self) -> dict[str, str]:
-        i = self.ctx.info
-        return {k: str(i.get(k)) for k in ("GL_VENDOR", "GL_RENDERER", "GL_VERSION")}
+        return context_info(self.ctx)
 
     # ------------------------------------------------------------------ programs
     def _program(self, lighting: str, where: str, shading: str, model: Any = None):
@@ -222,7 +223,7 @@ class Renderer:
         self._set(
             prog,
             "bkr_light_spot_direction",
-            arr(lambda L: np.asarray(L.spot_direction) / max(np.linalg.norm(L.spot_direction), 1e-300), 3),
+            arr(lambda L: normalize(np.asarray(L.spot_direction, dtype=np.float64)), 3),
         )
         self._set(prog, "bkr_light_spot_exponent", arr(lambda L: [L.spot_exponent], 1))
         self._set(
@@ -245,10 +246,7 @@ class Renderer:
             from . import glsl
             from .lighting import ambient_albedo
 
-            for name, value in glsl.uniform_values(m).items():
-                u = prog.get(name, None)
-                if u is not None:
-                    u.value = value
+            glsl.set_uniforms(prog, glsl.uniform_values(m))
             if glsl.is_measured(m):
                 if self._tables is None:
                     self._tables = glsl.TableTextures(self.ctx)
@@ -323,12 +321,7 @@ class Renderer:
     def _time_draws(self, scene: Scene, frames: int) -> float:
         import time
 
-        lighting = "opengl" if scene.is_opengl else "brdf"
-        where = "fragment" if scene.shading == "phong" else "vertex"
-        prog = self._program(lighting, where, scene.shading, scene.material)
-        self._set_common(prog, scene)
-        self._set_lights(prog, scene)
-        self._set_material(prog, scene)
+        prog = self._lit_program(scene)
         ctx = self.ctx
         w, h = scene.size
         samples = min(MSAA_SAMPLES, ctx.max_samples) if scene.antialias else 0
@@ -371,7 +364,8 @@ class Renderer:
                 img = self._render_glsl(scene)
         return np.ascontiguousarray(img[::-1])
 
-    def _render_glsl(self, scene: Scene) -> np.ndarray:
+    def _lit_program(self, scene: Scene):
+        """The GLSL path's program for ``scene``, with every uniform set (shared by rendering and timing)."""
         lighting = "opengl" if scene.is_opengl else "brdf"
         if not scene.is_opengl:
             from . import glsl
@@ -383,6 +377,10 @@ class Renderer:
         self._set_common(prog, scene)
         self._set_lights(prog, scene)
         self._set_material(prog, scene)
+        return prog
+
+    def _render_glsl(self, scene: Scene) -> np.ndarray:
+        prog = self._lit_program(scene)
         samples = MSAA_SAMPLES if scene.antialias else 0
         return self._draw(prog, scene, scene.size, samples)[0]
 
@@ -394,8 +392,7 @@ class Renderer:
             m = scene.mesh
             ph = np.c_[m.positions.astype(np.float64), np.ones(m.n_vertices)] @ mv.T
             P = ph[:, :3] / ph[:, 3:4]
-            n = m.normals.astype(np.float64) @ _normal_matrix(mv).T
-            n /= np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-300)
+            n = normalize(m.normals.astype(np.float64) @ _normal_matrix(mv).T)
             t = m.tangents.astype(np.float64) @ mv[:3, :3].T
             rgb = shade_points(scene.material, P, n, t, scene.lights, scene.light_model)
             colors = np.c_[rgb, np.ones(len(rgb))].astype(np.float32)

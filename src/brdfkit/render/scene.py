@@ -42,7 +42,7 @@ import numpy as np
 
 from .. import opengl
 from .camera import camera_matrices
-from .image import TONEMAPS, save_image, to_display
+from .image import TONEMAPS, save_image, to_display, to_uint8
 from .meshes import BUILTIN, Mesh, mesh_from_spec
 from .renderer import Scene, render_linear
 
@@ -97,9 +97,12 @@ class Frame:
 
     @property
     def uint8(self) -> np.ndarray:
-        from .image import to_uint8
-
         return to_uint8(self.display)
+
+
+_MATERIAL_FORMS = (
+    'material must be {"opengl": NAME or {...}}, {"model": NAME, "params": {...}}, {"measured": NAME} or {"merl": PATH}'
+)
 
 
 def material_from_spec(spec: Any) -> Any:
@@ -111,9 +114,7 @@ def material_from_spec(spec: Any) -> Any:
     if isinstance(spec, str):
         return opengl.material_from_json(spec)
     if not isinstance(spec, Mapping):
-        raise ValueError(
-        'material must be {"opengl": NAME or {...}}, {"model": NAME, "params": {...}}, {"measured": NAME} or {"merl": PATH}'
-    )
+        raise ValueError(_MATERIAL_FORMS)
     if "opengl" in spec:
         if set(spec) != {"opengl"}:
             raise ValueError("material with 'opengl' takes no other field")
@@ -136,9 +137,7 @@ def material_from_spec(spec: Any) -> Any:
         if not isinstance(params, Mapping):
             raise ValueError("material params must be an object of name: value")
         return bk.model(spec["model"], **dict(params))
-    raise ValueError(
-        'material must be {"opengl": NAME or {...}}, {"model": NAME, "params": {...}}, {"measured": NAME} or {"merl": PATH}'
-    )
+    raise ValueError(_MATERIAL_FORMS)
 
 
 def _size(value: Any) -> tuple[int, int]:
@@ -163,40 +162,22 @@ def scene_from_json(obj: Mapping[str, Any], base_dir: str | os.PathLike | None =
         mesh_spec = dict(mesh_spec)
         if not os.path.isabs(mesh_spec["path"]):
             mesh_spec["path"] = os.path.join(os.fspath(base_dir), mesh_spec["path"])
-    mesh = mesh_from_spec(mesh_spec)
     mat_spec = obj.get("material", {"opengl": "gold"})
     if isinstance(mat_spec, Mapping) and "merl" in mat_spec and base_dir is not None:
         if not os.path.isabs(mat_spec["merl"]):
             mat_spec = {"merl": os.path.join(os.fspath(base_dir), mat_spec["merl"])}
-    size = _size(obj.get("size", (512, 512)))
-    if size[1] <= 0:
-        raise ValueError(f"size must be positive, got {size}")
-    projection, modelview = camera_matrices(obj.get("camera"), size[0] / size[1])
-    lights_spec = obj.get("lights")
-    if lights_spec is None:
-        lights = list(DEFAULT_LIGHTS)
-    else:
-        if not isinstance(lights_spec, list):
-            raise ValueError("lights must be a list of light objects")
-        lights = [opengl.light_from_json(L) for L in lights_spec]
-    lm = opengl.light_model_from_json(obj.get("light_model"))
-    material = material_from_spec(mat_spec)
-    antialias = obj.get("antialias", True)
-    if not isinstance(antialias, bool):
-        raise ValueError(f"antialias must be true or false, got {antialias!r}")
-    scene = Scene(
-        mesh=mesh,
-        projection=projection,
-        modelview=modelview,
-        size=size,
-        lights=lights,
-        light_model=lm,
-        material=material,
+    scene = make_scene(
+        mesh=mesh_from_spec(mesh_spec),
+        material=mat_spec,
         shading=obj.get("shading", "phong"),
-        background=tuple(obj.get("background", (0.0, 0.0, 0.0, 1.0))),
-        antialias=antialias,
+        size=obj.get("size", (512, 512)),
+        camera=obj.get("camera"),
+        lights=obj.get("lights"),
+        light_model=obj.get("light_model"),
+        background=obj.get("background", (0.0, 0.0, 0.0, 1.0)),
+        antialias=obj.get("antialias", True),
     )
-    look = default_look(material)
+    look = default_look(scene.material)
     look = Look(
         obj.get("tonemap", look.tonemap),
         obj.get("exposure", look.exposure),
@@ -205,8 +186,8 @@ def scene_from_json(obj: Mapping[str, Any], base_dir: str | os.PathLike | None =
     return scene, look
 
 
-def load_scene(path: str | os.PathLike) -> tuple[Scene, Look]:
-    """Read a scene file."""
+def read_scene_file(path: str | os.PathLike) -> dict[str, Any]:
+    """A scene file's JSON object (not yet validated field by field)."""
     p = Path(path)
     if not p.is_file():
         raise OSError(f"scene file not found: {p}")
@@ -214,7 +195,14 @@ def load_scene(path: str | os.PathLike) -> tuple[Scene, Look]:
         obj = json.loads(p.read_text(encoding="utf-8"))
     except json.JSONDecodeError as e:
         raise ValueError(f"scene file {p} is not valid JSON: {e.msg} (line {e.lineno})") from None
-    return scene_from_json(obj, base_dir=p.parent)
+    if not isinstance(obj, dict):
+        raise ValueError("a scene must be a JSON object")
+    return obj
+
+
+def load_scene(path: str | os.PathLike) -> tuple[Scene, Look]:
+    """Read a scene file; relative paths in it are resolved against its folder."""
+    return scene_from_json(read_scene_file(path), base_dir=Path(path).parent)
 
 
 def make_scene(
@@ -228,11 +216,20 @@ def make_scene(
     background=(0.0, 0.0, 0.0, 1.0),
     antialias: bool = True,
 ) -> Scene:
-    """A :class:`Scene` from friendly arguments (names or objects)."""
+    """A :class:`Scene` from friendly arguments (names or objects); the scene-file fields, by keyword."""
     w, h = _size(size)
+    if h <= 0:
+        raise ValueError(f"size must be positive, got {(w, h)}")
     m = mesh if isinstance(mesh, Mesh) else mesh_from_spec(mesh)
     projection, modelview = camera_matrices(camera, w / h)
-    ls = list(DEFAULT_LIGHTS) if lights is None else [opengl.light_from_json(L) for L in lights]
+    if lights is None:
+        ls = list(DEFAULT_LIGHTS)
+    elif not isinstance(lights, (list, tuple)):
+        raise ValueError("lights must be a list of light objects")
+    else:
+        ls = [opengl.light_from_json(L) for L in lights]
+    if not isinstance(antialias, bool):
+        raise ValueError(f"antialias must be true or false, got {antialias!r}")
     return Scene(
         mesh=m,
         projection=projection,

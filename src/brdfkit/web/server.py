@@ -46,7 +46,6 @@ import numpy as np
 
 STATIC_DIR = Path(__file__).resolve().with_name("static")
 MAX_PAIRS = 100_000
-GLSL_TYPES = {"scalar": "float", "rgb": "vec3", "bool": "int", "choice": "int", "int": "int"}
 
 
 class BadRequest(ValueError):
@@ -72,7 +71,7 @@ def models_payload() -> dict[str, Any]:
             row["log_scale"] = bool(p.log_scale)
             row["open_lo"] = bool(p.open_lo)
             row["open_hi"] = bool(p.open_hi)
-            row["uniform"] = {"name": f"u_{p.name}", "type": GLSL_TYPES[p.kind]}
+            row["uniform"] = {"name": f"u_{p.name}", "type": glsl.GLSL_TYPES[p.kind]}
             if isinstance(row.get("min"), float) and not math.isfinite(row["min"]):
                 row["min"] = None
         info["glsl"] = glsl.has_shader(cls)
@@ -85,15 +84,10 @@ def shader_payload(name: str) -> str:
     from brdfkit import registry
     from brdfkit.render import glsl
 
-    try:
-        cls = registry.get(name)
+    try:  # an unknown model, or one without a GLSL file
+        return "#version 300 es\n" + glsl.shader_source(registry.get(name))
     except ValueError as e:
         raise BadRequest(str(e)) from None
-    try:
-        src = glsl.shader_source(cls)
-    except ValueError as e:
-        raise BadRequest(str(e)) from None
-    return "#version 300 es\n" + src
 
 
 def _parse_dirs(text: str, what: str) -> np.ndarray:

@@ -14,7 +14,7 @@
 // u_interpolation: 0 = nearest (MERL's reader), 1 = trilinear in index space
 // over the measured corners (θh, θd clamped, φd periodic), as
 // MERLBRDF.lookup_trilinear.
-// Needs common.glsl (bk_acos, bk_atan, bk_below, BK_PI) before it.
+// Needs common.glsl (bk_atan01, bk_below, BK_PI, BK_HALF_PI) before it.
 
 uniform highp sampler3D u_table;
 uniform int u_interpolation;

@@ -1,6 +1,7 @@
 // brdfkit renderer: the lights, with OpenGL's attenuation and spotlight rules
 // (OpenGL 2.1 §2.14.1). Shared by the fixed-function material (opengl_fixed.glsl)
-// and the BRDF materials (pipeline_brdf.glsl). numpy twin: brdfkit/render/lighting.py.
+// and the BRDF materials (pipeline_brdf.glsl). numpy twins: brdfkit.opengl.light_vector
+// and brdfkit.render.lighting.orthonormal_tangent.
 // Everything in eye space (the eye at the origin, looking down -z).
 // Written in the subset common to GLSL 3.30 and GLSL ES 3.00 (the caller adds #version).
 

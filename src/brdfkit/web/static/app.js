@@ -45,6 +45,7 @@
     if (a !== 0 && (a < 1e-3 || a >= 1e5)) return x.toExponential(3);
     return String(+x.toPrecision(4));
   };
+  // IEC 61966-2-1 sRGB transfer functions (Python twin: brdfkit.render.image.srgb_encode).
   const srgbToLinear = (c) => (c <= 0.04045 ? c / 12.92 : Math.pow((c + 0.055) / 1.055, 2.4));
   const linearToSrgb = (c) => (c <= 0.0031308 ? 12.92 * c : 1.055 * Math.pow(c, 1 / 2.4) - 0.055);
 
@@ -97,6 +98,7 @@ uniform float bkw_scale;       // light irradiance x 2^exposure
 uniform int bkw_tangent;       // 0: tangents along latitudes, 1: along longitudes
 uniform vec3 bkw_background;
 out vec4 bkw_color;
+// IEC 61966-2-1 sRGB encoding, as linearToSrgb above
 float bkw_srgb1(float c) { return c <= 0.0031308 ? 12.92 * c : 1.055 * pow(c, 1.0 / 2.4) - 0.055; }
 vec3 bkw_srgb(vec3 c) { c = clamp(c, 0.0, 1.0); return vec3(bkw_srgb1(c.r), bkw_srgb1(c.g), bkw_srgb1(c.b)); }
 void main() {
