@@ -154,15 +154,23 @@ def _centre_directions(i, j, k):
     return from_rusinkiewicz(th, 0.7 * np.ones_like(th), td, pd)
 
 
-def test_tabulate_save_load_round_trip(tmp_path):
-    model = _Glossy()
-    p = tmp_path / "g.binary"
-    bk.save_merl(model, p)
-    m = bk.load_merl(p)
-    rng = np.random.default_rng(3)
-    i, j, k = rng.integers(0, NH, 4000), rng.integers(0, ND, 4000), rng.integers(0, NP, 4000)
+def _save_load_at_centres(model, path, n, seed):
+    """Write ``model`` as a MERL file, read it back; ``n`` random bin centres as directions.
+
+    Returns ``(loaded model, (i, j, k) bin indices, wi, wo, both-above-the-horizon mask)``.
+    """
+    bk.save_merl(model, path)
+    m = bk.load_merl(path)
+    rng = np.random.default_rng(seed)
+    i, j, k = rng.integers(0, NH, n), rng.integers(0, ND, n), rng.integers(0, NP, n)
     wi, wo = _centre_directions(i, j, k)
     up = (wi[:, 2] > 0) & (wo[:, 2] > 0)
+    return m, (i, j, k), wi, wo, up
+
+
+def test_tabulate_save_load_round_trip(tmp_path):
+    model = _Glossy()
+    m, (i, j, k), wi, wo, up = _save_load_at_centres(model, tmp_path / "g.binary", 4000, seed=3)
     table_vals = np.moveaxis(m.table[:, i, j, k], 0, -1)
     # read back == the table at the bin centres, for nearest and trilinear lookups
     np.testing.assert_allclose(m.eval(wi[up], wo[up]), table_vals[up], rtol=1e-12)
@@ -300,13 +308,7 @@ def test_nbrdf_contract_float32_and_horizon():
 
 def test_material_to_merl_file(tmp_path):
     mat = bk.material("merl/blue-acrylic")
-    p = tmp_path / "blue.binary"
-    bk.save_merl(mat, p)
-    m = bk.load_merl(p)
-    rng = np.random.default_rng(7)
-    i, j, k = rng.integers(0, NH, 500), rng.integers(0, ND, 500), rng.integers(0, NP, 500)
-    wi, wo = _centre_directions(i, j, k)
-    up = (wi[:, 2] > 0) & (wo[:, 2] > 0)
+    m, _, wi, wo, up = _save_load_at_centres(mat, tmp_path / "blue.binary", 500, seed=7)
     np.testing.assert_allclose(m.eval(wi[up], wo[up]), mat.eval(wi[up], wo[up]), rtol=1e-9, atol=1e-12)
 
 

@@ -26,7 +26,6 @@ app = typer.Typer(
 )
 
 
-
 @app.callback()
 def _root() -> None:
     """brdfkit: every BRDF of the classic lecture, exact, checked, rendered, fitted."""

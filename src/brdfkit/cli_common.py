@@ -20,8 +20,9 @@ import math
 from typing import Any, Iterable
 
 import numpy as np
-
 import typer
+
+from .geometry import spherical_to_vector
 
 
 def model_from_cli(name: str, items: Iterable[str] | None = None):
@@ -95,8 +96,7 @@ def direction_from_degrees(text: str, what: str) -> np.ndarray:
     theta, phi = parse_pair(text, what)
     if not 0.0 <= theta <= 180.0:
         raise ValueError(f"{what}: theta must lie in [0, 180] degrees, got {theta:g}")
-    t, p = math.radians(theta), math.radians(phi)
-    v = np.array([math.sin(t) * math.cos(p), math.sin(t) * math.sin(p), math.cos(t)])
+    v = spherical_to_vector(math.radians(theta), math.radians(phi))
     # exact zeros at the axes and the horizon (cos(90°) is 6e-17 in floating point)
     v[np.abs(v) < 1e-15] = 0.0
     return v / np.linalg.norm(v)

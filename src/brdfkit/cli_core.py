@@ -93,9 +93,8 @@ def list_rows() -> list[dict[str, Any]]:
     return rows
 
 
-def eval_result(model_name: str, params: List[str], wi: np.ndarray, wo: np.ndarray) -> dict[str, Any]:
-    """What ``brdfkit eval --json`` prints."""
-    m = model_from_cli(model_name, params)
+def eval_result(m: Any, wi: np.ndarray, wo: np.ndarray) -> dict[str, Any]:
+    """What ``brdfkit eval --json`` prints for the model ``m`` at unit directions ``wi``, ``wo`` (3,)."""
     f = m.eval(wi, wo)
     return {
         "model": getattr(m, "label", m.name),
@@ -186,12 +185,10 @@ def register(app: typer.Typer) -> None:
         wi points toward the light, wo toward the viewer; the normal is +z and
         the tangent +x. Example: brdfkit eval ward -p alpha_x=0.1 --wi 30,0 --wo 30,180
         """
-        from .cli_common import model_from_cli
-
-        model_from_cli(model, param)  # an unknown model or bad -p first: the clearest message
+        m = model_from_cli(model, param)  # an unknown model or bad -p first: the clearest message
         v_in = _direction(wi, wi_vec, "wi")
         v_out = _direction(wo, wo_vec, "wo")
-        res = eval_result(model, param, v_in, v_out)
+        res = eval_result(m, v_in, v_out)
         if json_:
             print_json(res)
             return

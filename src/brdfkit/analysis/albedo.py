@@ -57,6 +57,8 @@ from typing import Any
 
 import numpy as np
 
+from ..geometry import normalize, reflect, rotate_z, spherical_to_vector
+
 # panel boundaries shared by both charts: 0, 1e-5, 2e-5, 4e-5, ... (doubling)
 _SMALLEST_PANEL = 1e-5
 _BREAKS = np.concatenate([[0.0], _SMALLEST_PANEL * 2.0 ** np.arange(0, 40)])
@@ -87,16 +89,6 @@ def _smoothstep(n: int) -> tuple[np.ndarray, np.ndarray]:
     return 3 * u**2 - 2 * u**3, w * 6 * u * (1 - u)
 
 
-def _rotate_z(v: np.ndarray, phi: float) -> np.ndarray:
-    if phi == 0.0:
-        return v
-    c, s = math.cos(phi), math.sin(phi)
-    out = v.copy()
-    out[..., 0] = c * v[..., 0] - s * v[..., 1]
-    out[..., 1] = s * v[..., 0] + c * v[..., 1]
-    return out
-
-
 def _panels(lo: np.ndarray, hi: np.ndarray, b: np.ndarray = _BREAKS) -> tuple[np.ndarray, np.ndarray]:
     """Clip the panels ``b`` to [lo, hi] (arrays broadcast): (starts, ends) of shape (..., P)."""
     a = np.clip(b[:-1], lo[..., None], hi[..., None])
@@ -107,9 +99,9 @@ def _panels(lo: np.ndarray, hi: np.ndarray, b: np.ndarray = _BREAKS) -> tuple[np
     return np.concatenate([a, tail_a], -1), np.concatenate([e, tail_e], -1)
 
 
-@functools.lru_cache(maxsize=64)
-def half_vector_rule(theta_o: float, phi_o: float, nr: int, na: int) -> tuple[np.ndarray, np.ndarray]:
-    """Nodes (M,3) and solid-angle weights (M,) over the upper hemisphere of wi, chart H."""
+@functools.lru_cache(maxsize=128)
+def _half_vector_rule0(theta_o: float, nr: int, na: int) -> tuple[np.ndarray, np.ndarray]:
+    """Chart H for wo in the xz-plane (φo = 0); see :func:`half_vector_rule`."""
     c, s = math.cos(theta_o), math.sin(theta_o)
     wo = np.array([s, 0.0, c])
     th_b = math.pi / 4 - theta_o / 2  # rings below are full circles
@@ -151,18 +143,16 @@ def half_vector_rule(theta_o: float, phi_o: float, nr: int, na: int) -> tuple[np
     TH = np.concatenate([n[0] for n in nodes])
     PH = np.concatenate([n[1] for n in nodes])
     W = np.concatenate(weights)
-    st = np.sin(TH)
-    h = np.stack([st * np.cos(PH), st * np.sin(PH), np.cos(TH)], -1)
+    h = spherical_to_vector(TH, PH)
     oh = h @ wo
-    wi = 2 * oh[:, None] * h - wo
-    wi /= np.linalg.norm(wi, axis=-1, keepdims=True)
-    W = W * st * 4 * np.maximum(oh, 0.0)
-    return _frozen(_rotate_z(wi, phi_o), W)
+    wi = normalize(reflect(wo, h))
+    W = W * np.sin(TH) * 4 * np.maximum(oh, 0.0)
+    return _frozen(wi, W)
 
 
-@functools.lru_cache(maxsize=64)
-def mirror_rule(theta_o: float, phi_o: float, nr: int, na: int) -> tuple[np.ndarray, np.ndarray]:
-    """Nodes (M,3) and solid-angle weights (M,) over the upper hemisphere of wi, chart R."""
+@functools.lru_cache(maxsize=128)
+def _mirror_rule0(theta_o: float, nr: int, na: int) -> tuple[np.ndarray, np.ndarray]:
+    """Chart R for wo in the xz-plane (φo = 0); see :func:`mirror_rule`."""
     c, s = math.cos(theta_o), math.sin(theta_o)
     r = np.array([-s, 0.0, c])
     t1 = np.array([c, 0.0, s])
@@ -194,7 +184,7 @@ def mirror_rule(theta_o: float, phi_o: float, nr: int, na: int) -> tuple[np.ndar
         + (sp * np.cos(B))[:, None] * t1
         + (sp * np.sin(B))[:, None] * t2
     )
-    return _frozen(_rotate_z(wi, phi_o), W)
+    return _frozen(wi, W)
 
 
 def _frozen(*arrays: np.ndarray) -> tuple[np.ndarray, ...]:
@@ -203,21 +193,16 @@ def _frozen(*arrays: np.ndarray) -> tuple[np.ndarray, ...]:
     return arrays
 
 
-@functools.lru_cache(maxsize=64)
-def polar_rule(theta_o: float, phi_o: float, nr: int, na: int) -> tuple[np.ndarray, np.ndarray]:
-    """Nodes (M,3) and solid-angle weights (M,) over the upper hemisphere of wi, chart D.
-
-    Gauss-Legendre in μ = cos θi and φi with breaks at θi = θo and at
-    φi − φo ∈ {0, π/2, π, 3π/2}: the kinks of diffuse models written with
-    max(θi, θo) and max(0, cos(φi − φo)) (Oren-Nayar) fall on panel edges.
-    """
+@functools.lru_cache(maxsize=128)
+def _polar_rule0(theta_o: float, nr: int, na: int) -> tuple[np.ndarray, np.ndarray]:
+    """Chart D for wo in the xz-plane (φo = 0); see :func:`polar_rule`."""
     mo = math.cos(theta_o)
     mb = np.unique(np.concatenate([np.linspace(0.0, mo, 3), np.linspace(mo, 1.0, 3)]))
     mb = mb[np.concatenate([[True], np.diff(mb) > 1e-12])]
     x, w = _gl(nr)
     mu = (mb[:-1, None] + np.diff(mb)[:, None] * x).ravel()
     wmu = (np.diff(mb)[:, None] * w).ravel()
-    pb = phi_o + np.arange(9) * (math.pi / 4)
+    pb = np.arange(9) * (math.pi / 4)
     xg, wg = _gl(max(4, na // 8))
     ph = (pb[:-1, None] + np.diff(pb)[:, None] * xg).ravel()
     wph = (np.diff(pb)[:, None] * wg).ravel()
@@ -226,6 +211,42 @@ def polar_rule(theta_o: float, phi_o: float, nr: int, na: int) -> tuple[np.ndarr
     wi = np.stack([st * np.cos(PH), st * np.sin(PH), MU], -1).reshape(-1, 3)
     W = (wmu[:, None] * wph[None, :]).ravel()
     return _frozen(wi, W)
+
+
+def _at_azimuth(rule0, theta_o: float, phi_o: float, nr: int, na: int) -> tuple[np.ndarray, np.ndarray]:
+    """The cached φo = 0 rule turned about the normal to φo (the rules depend on φo only so)."""
+    wi, w = rule0(float(theta_o), int(nr), int(na))
+    if phi_o != 0.0:
+        (wi,) = _frozen(rotate_z(wi, float(phi_o)))
+    return wi, w
+
+
+def half_vector_rule(theta_o: float, phi_o: float, nr: int, na: int) -> tuple[np.ndarray, np.ndarray]:
+    """Nodes (M,3) and solid-angle weights (M,) over the upper hemisphere of wi, chart H.
+
+    ``theta_o``, ``phi_o``: the viewing direction (radians); ``nr`` Gauss-Legendre
+    nodes per radial panel, ``na`` angular nodes (see :data:`LEVELS`). Read-only arrays.
+    """
+    return _at_azimuth(_half_vector_rule0, theta_o, phi_o, nr, na)
+
+
+def mirror_rule(theta_o: float, phi_o: float, nr: int, na: int) -> tuple[np.ndarray, np.ndarray]:
+    """Nodes (M,3) and solid-angle weights (M,) over the upper hemisphere of wi, chart R.
+
+    Arguments as :func:`half_vector_rule`.
+    """
+    return _at_azimuth(_mirror_rule0, theta_o, phi_o, nr, na)
+
+
+def polar_rule(theta_o: float, phi_o: float, nr: int, na: int) -> tuple[np.ndarray, np.ndarray]:
+    """Nodes (M,3) and solid-angle weights (M,) over the upper hemisphere of wi, chart D.
+
+    Gauss-Legendre in μ = cos θi and φi with breaks at θi = θo and at
+    φi − φo ∈ {0, π/2, π, 3π/2}: the kinks of diffuse models written with
+    max(θi, θo) and max(0, cos(φi − φo)) (Oren-Nayar) fall on panel edges.
+    Arguments as :func:`half_vector_rule`.
+    """
+    return _at_azimuth(_polar_rule0, theta_o, phi_o, nr, na)
 
 
 _CHARTS = {"H": half_vector_rule, "R": mirror_rule, "D": polar_rule}
@@ -286,9 +307,10 @@ def albedo_result(
     # results[chart][res] -> (n_angles, 3)
     results = {ch: [np.zeros((flat.size, 3)), np.zeros((flat.size, 3))] for ch in charts}
     # build all rules, evaluate in batches of at most max_nodes nodes
-    jobs = []  # (chart, res index, angle index, wi, w)
+    jobs = []  # (chart, res index, angle index, wo, wi, w)
+    wos = spherical_to_vector(flat, phi_o)  # (n, 3): the viewing directions
     for k, th in enumerate(flat):
-        wo = np.array([math.sin(th) * math.cos(phi_o), math.sin(th) * math.sin(phi_o), math.cos(th)])
+        wo = wos[k]
         for ch in charts:
             for ri, (nr, na) in enumerate(((n1r, n1a), (n2r, n2a))):
                 wi, w = _CHARTS[ch](float(th), float(phi_o), nr, na)
@@ -341,8 +363,7 @@ def albedo_result(
     err = errs[best, idx]
     if include_delta and hasattr(model, "delta_reflectance"):
         # the ideal-mirror part maps θ to θ (and is reciprocal): the same term for over="wi" and "wo"
-        w = np.stack([np.sin(flat) * math.cos(phi_o), np.sin(flat) * math.sin(phi_o), np.cos(flat)], axis=-1)
-        value = value + np.asarray(model.delta_reflectance(w), dtype=np.float64)
+        value = value + np.asarray(model.delta_reflectance(wos), dtype=np.float64)
     err = np.maximum(err, 1e-13 * np.max(np.abs(value), axis=-1))
     chart = np.asarray(charts)[best]
     return AlbedoResult(
@@ -388,7 +409,7 @@ def brute_force_albedo(model: Any, theta_o: float, phi_o: float = 0.0, n: int = 
     """
     mu = (np.arange(n) + 0.5) / n
     ph = 2 * math.pi * (np.arange(2 * n) + 0.5) / (2 * n)
-    wo = np.array([math.sin(theta_o) * math.cos(phi_o), math.sin(theta_o) * math.sin(phi_o), math.cos(theta_o)])
+    wo = spherical_to_vector(theta_o, phi_o)
     total = np.zeros(3)
     for m in mu.reshape(-1, 50) if n % 50 == 0 else [mu]:
         M, P = np.meshgrid(m, ph, indexing="ij")

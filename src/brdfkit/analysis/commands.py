@@ -8,38 +8,17 @@ from typing import Any, List, Optional
 
 import typer
 
-
-def _model(name: str, items: list[str]):
-    from brdfkit.cli_common import model_from_cli
-
-    return model_from_cli(name, items)
-
-
-def _echo_json(obj: Any) -> None:
-    from brdfkit.cli_common import print_json
-
-    print_json(obj)
-
-
-def _short(changed: dict[str, Any]) -> str:
-    from .plots import _fmt_value
-
-    if not changed:
-        return "defaults"
-    return ", ".join(f"{k}={_fmt_value(v)}" for k, v in changed.items())
+from ..cli_common import model_from_cli, print_json
 
 
 def _run_all(level: str, jobs: int, quiet: bool) -> list[dict[str, Any]]:
     """check_all, in ``jobs`` processes, with a rich progress bar on stderr."""
-    import brdfkit as bk
-
-    from .verdict import check, stress_settings
-
-    work = [(n, s) for n in bk.models() for s in stress_settings(n)]
-    results: list[Any] = [None] * len(work)
     from rich.console import Console
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
+    from .verdict import run_checks, stress_jobs
+
+    work = stress_jobs()
     console = Console(stderr=True)
     with Progress(
         TextColumn("checking {task.description:<32}"),
@@ -51,42 +30,16 @@ def _run_all(level: str, jobs: int, quiet: bool) -> list[dict[str, Any]]:
         transient=True,
     ) as prog:
         task = prog.add_task("", total=len(work))
-
-        def done(i: int, r: dict[str, Any]) -> None:
-            n, s = work[i]
-            r["setting"] = "stress" if s else "default"
-            r["changed"] = {k: (v.tolist() if hasattr(v, "tolist") else v) for k, v in s.items()}
-            results[i] = r
-            prog.update(task, advance=1, description=n)
-
-        if jobs > 1 and len(work) > 1:
-            import concurrent.futures as cf
-            import multiprocessing as mp
-
-            ctx = mp.get_context("fork") if "fork" in mp.get_all_start_methods() else None
-            with cf.ProcessPoolExecutor(max_workers=jobs, mp_context=ctx) as ex:
-                # expensive models first so the two workers finish together
-                order = sorted(range(len(work)), key=lambda i: work[i][0] != "htsg")
-                futs = {ex.submit(_check_one, work[i][0], work[i][1], level): i for i in order}
-                for f in cf.as_completed(futs):
-                    done(futs[f], f.result())
-        else:
-            for i, (n, s) in enumerate(work):
-                done(i, check(bk.model(n, **s), level=level))
-    return results
-
-
-def _check_one(name: str, setting: dict[str, Any], level: str) -> dict[str, Any]:
-    import brdfkit as bk
-
-    from .verdict import check
-
-    return check(bk.model(name, **setting), level=level)
+        return run_checks(
+            work, level=level, jobs=jobs, progress=lambda n, s, r: prog.update(task, advance=1, description=n)
+        )
 
 
 def _table(results: list[dict[str, Any]]) -> None:
     from rich.console import Console
     from rich.table import Table
+
+    from .plots import setting_text, where_text
 
     t = Table(title="brdfkit check --all: reciprocity and energy conservation", show_lines=False)
     for col, just in (
@@ -103,12 +56,12 @@ def _table(results: list[dict[str, Any]]) -> None:
     for r in results:
         t.add_row(
             r["model"],
-            _short(r.get("changed", {})),
+            setting_text(r.get("changed", {})),
             "yes" if r["reciprocal"] else "NO",
             f"{r['reciprocity_error']:.1e}",
             "yes" if r["energy_conserving"] else "NO",
             f"{r['max_albedo']:.4f}",
-            f"{r['max_albedo_theta_deg']:g}°" + (" (light)" if r["max_albedo_curve"] == "albedo_light" else ""),
+            where_text(r),
             f"{r['integration_error']:.0e}",
         )
     Console(width=max(150, int(os.environ.get("COLUMNS", "0") or 0))).print(t)
@@ -156,16 +109,16 @@ def register(app: typer.Typer) -> None:
 
                 save_figure(verdict_table_figure(results), plot_path)
             if json_out:
-                _echo_json(results)
+                print_json(results)
             else:
                 _table(results)
             return
         if model is None:
             raise ValueError("check: give a MODEL (see `brdfkit list`) or --all")
-        m = _model(model, param)
+        m = model_from_cli(model, param)
         r = check(m, level=level or "normal")
         if json_out:
-            _echo_json(r)
+            print_json(r)
             return
         from .plots import label
 
@@ -226,7 +179,7 @@ def register(app: typer.Typer) -> None:
             raise ValueError(f"plot: --exposure must be positive, got {exposure:g}")
         if not 16 <= size <= 4096:
             raise ValueError(f"plot: --size must lie in [16, 4096], got {size}")
-        models = [_model(n, items) for n, items in parse_model_groups(spec)]
+        models = [model_from_cli(n, items) for n, items in parse_model_groups(spec)]
         opts: dict[str, Any] = {"log": log}
         if kind == "polar":
             opts.update(theta_i_deg=theta_i, phi_i_deg=phi_i or 0.0, cosine=not no_cos)

@@ -15,7 +15,6 @@ from pathlib import Path
 import brdfkit as bk
 
 from . import plots
-from .plots import _fmt_value
 
 
 def albedo_models():
@@ -48,12 +47,11 @@ def markdown_table(results) -> str:
         "|---|---|---|---|---|---|---|",
     ]
     for r in results:
-        ch = r.get("changed", {})
-        setting = "defaults" if not ch else ", ".join(f"{k}={_fmt_value(v)}" for k, v in ch.items())
-        where = f"{r['max_albedo_theta_deg']:g}°" + (" (light)" if r.get("max_albedo_curve") == "albedo_light" else "")
         lines.append(
-            f"| {r['model']} | {setting} | {'yes' if r['reciprocal'] else '**no**'} | {r['reciprocity_error']:.1e} | "
-            f"{'yes' if r['energy_conserving'] else '**no**'} | {r['max_albedo']:.4f} ± {r['integration_error']:.0e} | {where} |"
+            f"| {r['model']} | {plots.setting_text(r.get('changed', {}))} | "
+            f"{'yes' if r['reciprocal'] else '**no**'} | {r['reciprocity_error']:.1e} | "
+            f"{'yes' if r['energy_conserving'] else '**no**'} | "
+            f"{r['max_albedo']:.4f} ± {r['integration_error']:.0e} | {plots.where_text(r)} |"
         )
     return "\n".join(lines)
 
@@ -62,9 +60,9 @@ def main(argv: list[str] | None = None) -> None:
     argv = sys.argv[1:] if argv is None else argv
     out = Path(argv[0] if argv else "docs/img")
     out.mkdir(parents=True, exist_ok=True)
-    from .commands import _run_all
+    from .verdict import check_all
 
-    results = _run_all("fast", 2, quiet=True)
+    results = check_all(level="fast", jobs=2)
     plots.save_figure(plots.verdict_table_figure(results), out / "verdict_table.png")
     pairs = albedo_models()
     fig = plots.albedo_plot(

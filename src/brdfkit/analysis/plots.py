@@ -23,6 +23,8 @@ from typing import Any, Sequence
 
 import numpy as np
 
+from ..geometry import spherical_to_vector
+
 KINDS = ("polar", "lobe", "albedo", "slice", "sphere")
 FORMATS = (".png", ".svg", ".pdf")
 _STYLES = ("-", "--", "-.", ":")
@@ -61,11 +63,24 @@ def label(model: Any, width: int | None = None) -> str:
     return text
 
 
-def _dir(theta, phi) -> np.ndarray:
-    theta = np.asarray(theta, dtype=np.float64)
-    phi = np.asarray(phi, dtype=np.float64)
-    st = np.sin(theta)
-    return np.stack(np.broadcast_arrays(st * np.cos(phi), st * np.sin(phi), np.cos(theta)), -1)
+def setting_text(changed: dict[str, Any]) -> str:
+    """A ``check --all`` result's ``changed`` parameters as ``k=v, ...`` (``defaults`` when none)."""
+    if not changed:
+        return "defaults"
+    return ", ".join(f"{k}={_fmt_value(v)}" for k, v in changed.items())
+
+
+def where_text(result: dict[str, Any]) -> str:
+    """Where a :func:`~brdfkit.analysis.check` result's max albedo lies: ``θ°``, ``(light)`` if on ρ."""
+    light = result.get("max_albedo_curve") == "albedo_light"
+    return f"{result['max_albedo_theta_deg']:g}°" + (" (light)" if light else "")
+
+
+def _light_dir(theta_i_deg: float, phi_i_deg: float) -> np.ndarray:
+    """The light direction wi (3,) of the polar and lobe plots; θi must lie in [0°, 90°)."""
+    if not 0.0 <= theta_i_deg < 90.0:
+        raise ValueError(f"plot: the light's theta must lie in [0, 90) degrees, got {theta_i_deg:g}")
+    return spherical_to_vector(math.radians(theta_i_deg), math.radians(phi_i_deg))
 
 
 def _luminance(rgb: np.ndarray) -> np.ndarray:
@@ -96,14 +111,17 @@ def polar_plot(
     cosine: bool = True,
     n: int = 721,
 ):
-    """In-plane polar plot of f_r·cos θo (``cosine=False``: f_r) with the light at θi."""
+    """In-plane polar plot of f_r·cos θo (``cosine=False``: f_r) with the light at θi.
+
+    ``theta_i_deg`` in [0, 90), ``phi_i_deg``: the light's direction in degrees.
+    ``log``: the radius is log10 of the value, spanning ``decades`` decades below
+    the largest value; ``n``: sample count of θo over (−90°, 90°).
+    """
     models = _check_models(models)
-    if not 0.0 <= theta_i_deg < 90.0:
-        raise ValueError(f"plot: the light's theta must lie in [0, 90) degrees, got {theta_i_deg:g}")
-    wi = _dir(math.radians(theta_i_deg), math.radians(phi_i_deg))
+    wi = _light_dir(theta_i_deg, phi_i_deg)
     # plotting angle a in (−90°, 90°): a > 0 is the mirror side (azimuth φi + 180°)
     a = np.radians(np.linspace(-89.9, 89.9, n))
-    wo = _dir(np.abs(a), np.where(a >= 0, math.radians(phi_i_deg) + math.pi, math.radians(phi_i_deg)))
+    wo = spherical_to_vector(np.abs(a), np.where(a >= 0, math.radians(phi_i_deg) + math.pi, math.radians(phi_i_deg)))
     curves = []
     for m in models:
         f = np.asarray(m.eval(wi, wo), dtype=np.float64)
@@ -163,16 +181,18 @@ def lobe_plot(
     n_theta: int = 60,
     n_phi: int = 120,
 ):
-    """3D lobe r(wo) = f_r(wi, wo) cos θo along wo (one panel per model)."""
+    """3D lobe r(wo) = f_r(wi, wo) cos θo along wo (one panel per model).
+
+    Light direction and ``log``/``decades`` as :func:`polar_plot`; each panel is
+    normalised to its own maximum; ``n_theta`` × ``n_phi`` grid over the hemisphere.
+    """
     from matplotlib import cm
 
     models = _check_models(models)
-    if not 0.0 <= theta_i_deg < 90.0:
-        raise ValueError(f"plot: the light's theta must lie in [0, 90) degrees, got {theta_i_deg:g}")
-    wi = _dir(math.radians(theta_i_deg), math.radians(phi_i_deg))
-    # denser near the mirror direction: sample θo uniformly, φo uniformly
+    wi = _light_dir(theta_i_deg, phi_i_deg)
+    # a regular (θo, φo) grid, θo up to 89.5° (the lobe's rim at the horizon)
     T, P = np.meshgrid(np.radians(np.linspace(0, 89.5, n_theta)), np.linspace(0, 2 * math.pi, n_phi), indexing="ij")
-    wo = _dir(T, P)
+    wo = spherical_to_vector(T, P)
     fig = _figure(5.8 * len(models), 5.6)
     for k, m in enumerate(models):
         v = _luminance(np.asarray(m.eval(wi, wo), dtype=np.float64)) * wo[..., 2]
@@ -210,7 +230,13 @@ def albedo_plot(
     labels: Sequence[str] | None = None,
     show_light: bool = True,
 ):
-    """Albedo curves a(θ) (solid) and, for non-reciprocal models, ρ(θ) (dotted)."""
+    """Albedo curves a(θ) (solid) and, for non-reciprocal models, ρ(θ) (dotted).
+
+    ``theta_deg``: the polar angles in degrees (default 0° to 89.5°), ``phi_deg``
+    the azimuth of the scan; ``level`` the quadrature level of
+    :func:`~brdfkit.analysis.albedo.albedo`; ``labels`` replace the legend entries;
+    ``show_light=False`` omits the ρ curves.
+    """
     from .albedo import albedo_result
     from .reciprocity import reciprocity_error, RECIPROCITY_TOL
 
@@ -254,7 +280,7 @@ def albedo_plot(
 
 # ---------------------------------------------------------------------------------------------
 def slice_plot(models: Sequence[Any], *, phi_d_deg: float = 90.0, log: bool = True, n: int = 256):
-    """Rusinkiewicz image slice: f_r over θh (x) × θd (y) at fixed φd."""
+    """Rusinkiewicz image slice: f_r over θh (x) × θd (y), ``n`` × ``n`` pixels over [0°, 90°]², at φd in degrees."""
     from matplotlib.colors import LogNorm, Normalize
 
     from ..geometry import from_rusinkiewicz
@@ -300,15 +326,14 @@ def sphere_image(
     *,
     size: int = 256,
     exposure: float = 1.0,
-    ambient: float = 0.0,
 ) -> np.ndarray:
     """Linear-RGB radiance image (size, size, 3) of a unit sphere under a directional light.
 
-    Orthographic camera on +z looking at the sphere, light of unit irradiance from
-    (θ, φ) in camera space (θ from the view axis, φ from +x toward +y). At each
-    pixel the BRDF frame has the sphere normal as n and the surface direction of
-    the projected +x axis as tangent. Radiance = f_r(wi, wo) cos θi · exposure
-    (+ ambient·kd-like term 0 unless asked); background NaN.
+    Orthographic camera on +z looking at the sphere (pixel centres sample
+    [−1, 1]², +y up), light of unit irradiance from (θ, φ) in camera space, in
+    degrees (θ from the view axis, φ from +x toward +y). At each pixel the BRDF
+    frame has the sphere normal as n and the surface direction of the projected
+    +x axis as tangent. Radiance = f_r(wi, wo) cos θi · exposure; background NaN.
     """
     from ..geometry import to_local
 
@@ -322,20 +347,15 @@ def sphere_image(
     tl = np.linalg.norm(t, axis=-1, keepdims=True)
     t = np.where(tl > 1e-9, t / np.where(tl > 0, tl, 1), np.array([0.0, 1.0, 0.0]))
     b = np.cross(nrm, t)
-    L = _dir(math.radians(light_theta_deg), math.radians(light_phi_deg))
+    L = spherical_to_vector(math.radians(light_theta_deg), math.radians(light_phi_deg))
     V = np.array([0.0, 0.0, 1.0])
     wi = to_local(np.broadcast_to(L, nrm.shape), t, b, nrm)
     wo = to_local(np.broadcast_to(V, nrm.shape), t, b, nrm)
     f = np.asarray(model.eval(wi, wo), dtype=np.float64)
-    rad = f * np.maximum(wi[:, 2:3], 0) * exposure + ambient
+    rad = f * np.maximum(wi[:, 2:3], 0) * exposure
     img = np.full((size, size, 3), np.nan)
     img[inside] = rad
     return img
-
-
-def _to_srgb(x: np.ndarray) -> np.ndarray:
-    x = np.clip(x, 0, 1)
-    return np.where(x <= 0.0031308, 12.92 * x, 1.055 * np.power(x, 1 / 2.4) - 0.055)
 
 
 def sphere_plot(
@@ -347,7 +367,13 @@ def sphere_plot(
     exposure: float = 1.0,
     log: bool = False,
 ):
-    """Lit spheres side by side (sRGB, clipped at 1; ``log``: log-compressed tone map)."""
+    """Lit spheres side by side (sRGB, clipped at 1; ``log``: log-compressed tone map).
+
+    Light (θ, φ) in degrees from the view axis, ``size`` pixels, ``exposure`` a
+    radiance scale: see :func:`sphere_image`.
+    """
+    from ..render.image import srgb_encode  # numpy only (no OpenGL at import time)
+
     models = _check_models(models)
     fig = _figure(3.6 * len(models), 4.0)
     for k, m in enumerate(models):
@@ -356,7 +382,7 @@ def sphere_plot(
         lin = np.nan_to_num(img)
         if log:
             lin = np.log1p(lin * 100.0) / math.log1p(100.0 * max(float(lin.max()), 1e-12))
-        out = _to_srgb(lin)
+        out = srgb_encode(lin)
         out[bg] = 0.15
         ax = fig.add_subplot(1, len(models), k + 1)
         ax.imshow(out, interpolation="nearest")
@@ -377,10 +403,8 @@ def verdict_table_figure(results: Sequence[dict[str, Any]], title: str | None = 
     colors = []
     good, bad, plain = "#d9f2d9", "#f8d0d0", "#ffffff"
     for r in results:
-        changed = r.get("changed", {})
-        setting = "defaults" if not changed else ", ".join(f"{k}={_fmt_value(v)}" for k, v in changed.items())
-        setting = "\n".join(textwrap.wrap(setting, 46)) or "defaults"
-        where = f"{r['max_albedo_theta_deg']:g}°" + (" (light)" if r.get("max_albedo_curve") == "albedo_light" else "")
+        setting = "\n".join(textwrap.wrap(setting_text(r.get("changed", {})), 46))
+        where = where_text(r)
         rows.append(
             [
                 r["model"],

@@ -29,6 +29,8 @@ from typing import Any
 
 import numpy as np
 
+from ..geometry import spherical_to_vector
+
 #: a model is called reciprocal when its relative asymmetry is at most this
 RECIPROCITY_TOL = 1e-6
 
@@ -37,18 +39,13 @@ _N_PHI = 24
 _TILTS_DEG = (0.0, 0.3, -0.3, 1.0, -1.0, 3.0, -3.0)
 
 
-def _dirs(theta, phi) -> np.ndarray:
-    st = np.sin(theta)
-    return np.stack([st * np.cos(phi), st * np.sin(phi), np.cos(theta)], -1)
-
-
 @functools.lru_cache(maxsize=4)
 def direction_pairs(n_random: int = 20000, seed: int = 20241) -> tuple[np.ndarray, np.ndarray]:
     """The deterministic test set: arrays ``(a, b)`` of shape (N, 3), unit, upper hemisphere."""
     th = np.radians(np.asarray(_THETA_DEG))
     ph = 2 * math.pi * np.arange(_N_PHI) / _N_PHI + 0.1  # off-axis offset
     T, P = np.meshgrid(th[1:], ph, indexing="ij")
-    grid = np.concatenate([_dirs(T.ravel(), P.ravel()), [[0.0, 0.0, 1.0]]])
+    grid = np.concatenate([spherical_to_vector(T.ravel(), P.ravel()), [[0.0, 0.0, 1.0]]])
     ia, ib = np.triu_indices(len(grid), k=1)
     a_list = [grid[ia]]
     b_list = [grid[ib]]
@@ -61,7 +58,7 @@ def direction_pairs(n_random: int = 20000, seed: int = 20241) -> tuple[np.ndarra
     tb = np.clip(ta + np.tile(TT.ravel(), len(grid)), 1e-4, math.radians(89.95))
     pb = pa + math.pi + np.tile(PT.ravel(), len(grid))
     a_list.append(A)
-    b_list.append(_dirs(tb, pb))
+    b_list.append(spherical_to_vector(tb, pb))
     # random pairs
     rng = np.random.default_rng(seed)
     for out in (a_list, b_list):

@@ -36,27 +36,10 @@ from typing import Any, Sequence
 
 import numpy as np
 
+from ..geometry import frame_from_normal, half_vector, reflect, spherical_to_vector
+from .albedo import _gl
+
 _INV_PI = 1.0 / math.pi
-
-
-def _frame(r: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Two unit vectors orthogonal to unit ``r`` (Duff et al. 2017)."""
-    sign = 1.0 if r[2] >= 0 else -1.0
-    a = -1.0 / (sign + r[2])
-    b = r[0] * r[1] * a
-    t = np.array([1 + sign * r[0] ** 2 * a, sign * b, -sign * r[0]])
-    s = np.array([b, sign + r[1] ** 2 * a, -r[1]])
-    return t, s
-
-
-def _reflect(wo: np.ndarray, h: np.ndarray) -> np.ndarray:
-    return 2 * (h @ wo)[:, None] * h - wo
-
-
-def _half(wo: np.ndarray, wi: np.ndarray) -> np.ndarray:
-    h = wi + wo
-    n = np.linalg.norm(h, axis=-1, keepdims=True)
-    return h / np.where(n > 0, n, 1.0)
 
 
 class Sampler:
@@ -84,16 +67,15 @@ class PhongLobe(Sampler):
     s: float
 
     def sample(self, wo, u):
-        r = np.array([-wo[0], -wo[1], wo[2]])
-        t, b = _frame(r)
+        r = reflect(wo)
+        t, b = frame_from_normal(r)
         c = np.power(1 - u[:, 0], 1.0 / (self.s + 1))  # 1 − u avoids 0^(1/(s+1)) issues
         sn = np.sqrt(np.maximum(0.0, 1 - c * c))
         phi = 2 * math.pi * u[:, 1]
         return c[:, None] * r + (sn * np.cos(phi))[:, None] * t + (sn * np.sin(phi))[:, None] * b
 
     def pdf(self, wo, wi):
-        r = np.array([-wo[0], -wo[1], wo[2]])
-        x = np.maximum(wi @ r, 0.0)
+        x = np.maximum(wi @ reflect(wo), 0.0)
         return (self.s + 1) / (2 * math.pi) * np.where(x > 0, np.power(x, self.s), 0.0)
 
 
@@ -109,7 +91,7 @@ class BlinnLobe(Sampler):
         return _valid_reflection(wo, h)
 
     def pdf(self, wo, wi):
-        h = _half(wo, wi)
+        h = half_vector(wi, wo)
         c = np.maximum(h[..., 2], 0.0)
         ph = (self.s + 2) / (2 * math.pi) * np.power(c, self.s + 1)
         return _h_to_wi(ph, wo, h)
@@ -117,7 +99,7 @@ class BlinnLobe(Sampler):
 
 def _valid_reflection(wo: np.ndarray, h: np.ndarray) -> np.ndarray:
     oh = h @ wo
-    wi = _reflect(wo, h)
+    wi = reflect(wo, h)
     wi[oh <= 0] = np.nan  # h faces away from wo: no reflection (the pdf does not count it)
     return wi
 
@@ -163,7 +145,7 @@ class MicrofacetH(Sampler):
         return _valid_reflection(wo, h)
 
     def pdf(self, wo, wi):
-        h = _half(wo, wi)
+        h = half_vector(wi, wo)
         return _h_to_wi(self._d_cos(h), wo, h)
 
 
@@ -197,7 +179,7 @@ class GGXVisible(Sampler):
         return _valid_reflection(wo, h)
 
     def pdf(self, wo, wi):
-        h = _half(wo, wi)
+        h = half_vector(wi, wo)
         d_cos = MicrofacetH("ggx", self.alpha_x, self.alpha_y)._d_cos(h)
         c = np.maximum(h[..., 2], 1e-300)
         oh = h @ wo
@@ -313,8 +295,7 @@ def chi2_test(
     obs, _, _ = np.histogram2d(
         np.clip(wi[:, 2], 0, 1), np.mod(np.arctan2(wi[:, 1], wi[:, 0]), 2 * math.pi), bins=[zb, pb]
     )
-    x, w = np.polynomial.legendre.leggauss(sub)
-    x, w = 0.5 * (x + 1), 0.5 * w
+    x, w = _gl(sub)  # Gauss-Legendre on [0, 1]
     z = (zb[:-1, None] + np.diff(zb)[:, None] * x).ravel()
     wz = (np.diff(zb)[:, None] * w).ravel()
     ph = (pb[:-1, None] + np.diff(pb)[:, None] * x).ravel()
@@ -354,7 +335,7 @@ def albedo_mc(model: Any, theta_o: float, *, n: int = 200_000, seed: int = 0, sa
     """
     if not 0 <= theta_o < math.pi / 2:
         raise ValueError("albedo_mc: theta_o must lie in [0, π/2)")
-    wo = np.array([math.sin(theta_o), 0.0, math.cos(theta_o)])
+    wo = spherical_to_vector(theta_o, 0.0)
     s = sampler or sampler_for(model)
     rng = np.random.default_rng(seed)
     wi = s.sample(wo, rng.random((n, 2)))

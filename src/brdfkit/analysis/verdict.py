@@ -8,6 +8,7 @@ from typing import Any, Iterable
 
 import numpy as np
 
+from ..geometry import rotate_z
 from .albedo import DEFAULT_LEVEL, albedo_result
 from .reciprocity import RECIPROCITY_TOL, reciprocity_report
 
@@ -48,9 +49,7 @@ def effectively_isotropic(model: Any, tol: float = 1e-9) -> bool:
     f0 = np.asarray(model.eval(a, b), dtype=np.float64)
     scale = float(np.abs(f0).max()) or 1.0
     for ang in (0.7, 1.9, 2.9, 4.4):
-        c, s = math.cos(ang), math.sin(ang)
-        R = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
-        f1 = np.asarray(model.eval(a @ R.T, b @ R.T), dtype=np.float64)
+        f1 = np.asarray(model.eval(rotate_z(a, ang), rotate_z(b, ang)), dtype=np.float64)
         big = np.maximum(np.abs(f0), np.abs(f1))
         rel = np.abs(f1 - f0) / np.maximum(big, 1e-12 * scale)
         if float(rel.max()) > tol:
@@ -234,24 +233,64 @@ def stress_settings(name: str) -> list[dict[str, Any]]:
     return out
 
 
-def check_all(*, level: str = "fast", names: Iterable[str] | None = None, progress=None) -> list[dict[str, Any]]:
-    """:func:`check` for every registered model at its defaults and stress settings.
-
-    Each result carries ``setting`` (``"default"`` or ``"stress"``) and
-    ``changed`` (the parameters set away from the defaults).
-    """
+def stress_jobs(names: Iterable[str] | None = None) -> list[tuple[str, dict[str, Any]]]:
+    """``(model name, setting)`` pairs of ``check --all``: every model (or ``names``) × :func:`stress_settings`."""
     import brdfkit as bk
 
-    jobs = [(n, s) for n in (list(names) if names is not None else bk.models()) for s in stress_settings(n)]
-    results = []
-    for n, s in jobs:
-        r = check(bk.model(n, **s), level=level)
-        r["setting"] = "stress" if s else "default"
-        r["changed"] = {k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in s.items()}
-        results.append(r)
+    return [(n, s) for n in (list(names) if names is not None else bk.models()) for s in stress_settings(n)]
+
+
+def _check_setting(name: str, setting: dict[str, Any], level: str) -> dict[str, Any]:
+    """:func:`check` of one model at one setting, tagged with ``setting`` and ``changed``."""
+    import brdfkit as bk
+
+    r = check(bk.model(name, **setting), level=level)
+    r["setting"] = "stress" if setting else "default"
+    r["changed"] = {k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in setting.items()}
+    return r
+
+
+def run_checks(
+    work: list[tuple[str, dict[str, Any]]], *, level: str = "fast", jobs: int = 1, progress=None
+) -> list[dict[str, Any]]:
+    """:func:`check` every ``(name, setting)`` of ``work`` (in ``jobs`` processes); results in ``work`` order.
+
+    ``progress(name, setting, result)`` is called as each one finishes.
+    """
+    results: list[Any] = [None] * len(work)
+
+    def done(i: int, r: dict[str, Any]) -> None:
+        results[i] = r
         if progress is not None:
-            progress(n, s, r)
+            progress(work[i][0], work[i][1], r)
+
+    if jobs > 1 and len(work) > 1:
+        import concurrent.futures as cf
+        import multiprocessing as mp
+
+        ctx = mp.get_context("fork") if "fork" in mp.get_all_start_methods() else None
+        with cf.ProcessPoolExecutor(max_workers=jobs, mp_context=ctx) as ex:
+            # the expensive model (htsg) first, so that the workers finish together
+            order = sorted(range(len(work)), key=lambda i: work[i][0] != "htsg")
+            futs = {ex.submit(_check_setting, work[i][0], work[i][1], level): i for i in order}
+            for f in cf.as_completed(futs):
+                done(futs[f], f.result())
+    else:
+        for i, (n, s) in enumerate(work):
+            done(i, _check_setting(n, s, level))
     return results
 
 
-__all__ = ["check", "check_all", "stress_settings", "STRESS", "DEFAULT_THETA_DEG"]
+def check_all(
+    *, level: str = "fast", names: Iterable[str] | None = None, progress=None, jobs: int = 1
+) -> list[dict[str, Any]]:
+    """:func:`check` for every registered model at its defaults and stress settings.
+
+    Each result carries ``setting`` (``"default"`` or ``"stress"``) and
+    ``changed`` (the parameters set away from the defaults). ``jobs``: worker
+    processes; ``progress(name, setting, result)`` as in :func:`run_checks`.
+    """
+    return run_checks(stress_jobs(names), level=level, jobs=jobs, progress=progress)
+
+
+__all__ = ["check", "check_all", "run_checks", "stress_jobs", "stress_settings", "STRESS", "DEFAULT_THETA_DEG"]

@@ -15,6 +15,8 @@ from typing import Any, List, Optional
 import numpy as np
 import typer
 
+from ..cli_common import print_json
+
 
 def measured_names(set_name: str | None = None) -> list[str]:
     """The built-in measured materials (``set/name``), optionally of one set (merl, rgl, nielsen)."""
@@ -154,7 +156,7 @@ def _single(source, model_name, param, metric, starts, samples, seed, as_json, r
 
         out["report"] = write_report(res, measured, report)
     if as_json:
-        typer.echo(json.dumps(out, indent=2))
+        print_json(out)
         return
     typer.echo(f"{model_name} fitted to {res.source}: error {res.error:.6g} ({metric}), "
                f"{res.samples} samples, {res.starts} starts, {res.seconds:.1f} s")
@@ -182,8 +184,8 @@ def _batch(models, param, metric, starts, samples, seed, set_name, limit, out, a
     seconds = time.perf_counter() - t0
     paths = write_batch(results, list(models), sources, out, metric, seconds)
     if as_json:
-        typer.echo(json.dumps({"metric": metric, "seconds": round(seconds, 2), "files": paths,
-                               "results": [r.to_json() for r in results]}, indent=2))
+        print_json({"metric": metric, "seconds": round(seconds, 2), "files": paths,
+                    "results": [r.to_json() for r in results]})
         return
     typer.echo(f"fitted {len(models)} model(s) to {len(sources)} material(s) in {seconds:.1f} s")
     for k, v in paths.items():
@@ -194,7 +196,7 @@ def list_measured(as_json: bool = False) -> None:
     """What ``brdfkit list --measured`` prints: the built-in measured materials."""
     names = measured_names()
     if as_json:
-        typer.echo(json.dumps(names, indent=2))
+        print_json(names)
         return
     from .nbrdf import SETS
 

@@ -14,7 +14,9 @@ square-root θh mapping puts many of them in the specular peak), with random
 normal. From a MERL table the samples are bin centres of measured bins and the
 values are the table's; from any other model the model is evaluated. Each
 sample carries the weight ``sin θh · dθh/du · sin θd cos θd`` (the Jacobian of
-the half/difference parameterisation over the sampling density), so every
+the half/difference parameterisation, dωi dωo = 4 cos θd dωh dωd with
+dωh = sin θh dθh dφh, dωd = sin θd dθd dφd, over the sampling density; the
+constant 4 cancels in the normalisation; θh = u² π/2 so dθh/du = π u), so every
 metric below estimates an integral over pairs of directions (ωi, ωo), normalised
 by the integral of the weight.
 
@@ -51,7 +53,7 @@ import numpy as np
 from ..geometry import from_rusinkiewicz
 from ..models.base import BRDF
 from ..params import Param, to_jsonable
-from .merl import HALF_PI, MERLBRDF, RES_PHI_D, RES_THETA_D, RES_THETA_H, load_merl
+from .merl import HALF_PI, MERLBRDF, RES_PHI_D, RES_THETA_D, RES_THETA_H, bin_centres, load_merl
 
 METRICS = ("ngan", "l2", "log", "cbrt")
 METRIC_TITLES = {
@@ -116,6 +118,7 @@ def sample(measured: Any, n: int = 3000, seed: int = 0, max_theta_deg: float = 8
     rng = np.random.default_rng(seed)
     cos_max = math.cos(math.radians(max_theta_deg)) if max_theta_deg < 90 else 0.0
     is_table = isinstance(model, MERLBRDF)
+    _, centre_td, centre_pd = bin_centres()
     wi_l, wo_l, f_l, w_l = [], [], [], []
     have = 0
     for _round in range(20):
@@ -124,9 +127,8 @@ def sample(measured: Any, n: int = 3000, seed: int = 0, max_theta_deg: float = 8
             i = rng.integers(0, RES_THETA_H, m)
             j = rng.integers(0, RES_THETA_D, m)
             k = rng.integers(0, RES_PHI_D, m)
-            u = (i + 0.5) / RES_THETA_H
-            td = (j + 0.5) / RES_THETA_D * HALF_PI
-            pd = (k + 0.5) / RES_PHI_D * np.pi
+            u = (i + 0.5) / RES_THETA_H  # θh's bin centre in index space (θh = u² π/2 below)
+            td, pd = centre_td[j], centre_pd[k]
         else:
             u = rng.random(m)
             td = rng.random(m) * HALF_PI
@@ -258,6 +260,7 @@ class ParamPacker:
                         and by_name[a].fit and by_name[b].fit:
                     tied[a] = b
         self.tied = tied
+        self.frozen: list[str] = []  # parameters held at their defaults by freeze()
         skip = set(tied.values())
         self.slots: list[_Slot] = []
         for p in cls.spec:
@@ -283,7 +286,7 @@ class ParamPacker:
         # an rgb parameter is frozen only as a whole
         names = {n for n in names if all(i in drop for i, s in enumerate(self.slots) if s.param.name == n)}
         self.slots = [s for s in self.slots if s.param.name not in names]
-        self.frozen = sorted(set(getattr(self, "frozen", [])) | names)
+        self.frozen = sorted(set(self.frozen) | names)
         self._update_bounds()
 
     def __len__(self) -> int:
@@ -291,7 +294,7 @@ class ParamPacker:
 
     def params(self, x: np.ndarray) -> dict[str, Any]:
         out = dict(self.given)
-        for n in getattr(self, "frozen", []):
+        for n in self.frozen:
             out[n] = self.defaults[n]
         rgb: dict[str, list[float]] = {}
         for s, xv in zip(self.slots, x):
@@ -448,11 +451,9 @@ def fit(
         return FitResult(model, dict(model.params), err, metric, data.source, len(data), 0, 1,
                          time.perf_counter() - t0, sorted(packer.fixed_names), [], [err])
     # from here on the model is built from the free values
-
-
     rng = np.random.default_rng(seed + 1)
+    nfev += 2 * (len(packer) + 1)  # _freeze_unused: at most 2 points × (base + one probe per slot)
     _freeze_unused(packer, residuals, rng)
-    nfev += 3 * (len(packer) + 1)
     x_default = packer.x_of(packer.fixed)
     cand = [x_default]
     if candidates > 0:
@@ -504,7 +505,7 @@ def fit(
     err = error(model, data, metric)
     return FitResult(
         model, dict(model.params), err, metric, data.source, len(data), total, nfev,
-        time.perf_counter() - t0, sorted(packer.fixed_names), list(getattr(packer, "frozen", [])), start_errors,
+        time.perf_counter() - t0, sorted(packer.fixed_names), list(packer.frozen), start_errors,
         len(packer),
     )
 

@@ -41,7 +41,7 @@ from typing import Any
 
 import numpy as np
 
-from ..geometry import from_rusinkiewicz
+from ..geometry import from_rusinkiewicz, half_vector
 from ..models.base import BRDF
 from ..params import Param
 
@@ -105,8 +105,7 @@ def symmetric_half_diff(wi, wo) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """
     wi = np.asarray(wi, dtype=np.float64)
     wo = np.asarray(wo, dtype=np.float64)
-    h = wi + wo
-    h = h / np.maximum(np.linalg.norm(h, axis=-1, keepdims=True), 1e-300)
+    h = half_vector(wi, wo)  # built from wi + wo, which is symmetric in the pair
     theta_h = np.arccos(np.clip(h[..., 2], -1.0, 1.0))
     phi_h = np.arctan2(h[..., 1], h[..., 0])
     ch, sh = np.cos(phi_h), np.sin(phi_h)
@@ -178,7 +177,6 @@ class MERLBRDF(MeasuredBRDF):
         table = np.where(np.isfinite(table), table, -1.0)
         self.table = table
         self.table.setflags(write=False)
-        self.valid = (table >= 0).all(axis=0)
         self.label = label
         self.source = source
         super().__init__(interpolation=interpolation)
@@ -247,10 +245,21 @@ def tabulate(model: BRDF, chunk: int = 6) -> np.ndarray:
     for i0 in range(0, RES_THETA_H, chunk):
         TH, TD, PD = np.meshgrid(th[i0 : i0 + chunk], td, pd, indexing="ij")
         wi, wo = from_rusinkiewicz(TH, np.zeros_like(TH), TD, PD)
-        valid = (wi[..., 2] > 0) & (wo[..., 2] > 0)
-        f = np.asarray(model.eval(wi, wo), dtype=np.float64)
-        f = np.where(valid[..., None], np.maximum(f, 0.0), MISSING * SCALES)
+        valid = (wi[..., 2] > 0) & (wo[..., 2] > 0)  # a quarter of the bins lie below the horizon
+        f = np.broadcast_to(MISSING * SCALES, valid.shape + (3,)).copy()
+        f[valid] = np.maximum(np.asarray(model.eval(wi[valid], wo[valid]), dtype=np.float64), 0.0)
         out[:, i0 : i0 + chunk] = np.moveaxis(f, -1, 0)
+    return out
+
+
+def table_rgba(model: BRDF) -> np.ndarray:
+    """The table as float32 texels ``(90, 90, 180, 4)`` = [θh][θd][φd][rgba], OpenGL's
+    (depth, height, width, components): rgb = each channel clamped at 0 (as :meth:`MERLBRDF.eval`
+    does), alpha = 1 where every channel was measured, else 0 (trilinear lookups skip those)."""
+    t = tabulate(model)  # (3, 90, 90, 180), negative = missing
+    out = np.empty(t.shape[1:] + (4,), dtype=np.float32)
+    out[..., :3] = np.moveaxis(np.maximum(t, 0.0), 0, -1)
+    out[..., 3] = (t >= 0).all(axis=0)
     return out
 
 
@@ -263,9 +272,8 @@ def texture3d(model: BRDF) -> np.ndarray:
     ``(k+½)/180``, ``(j+½)/90``, ``(i+½)/90`` — nearest or linear filtering
     (φd repeats, θh and θd clamp to edge).
     """
-    t = tabulate(model)
-    t = np.where((t >= 0).all(axis=0, keepdims=True), t, 0.0)
-    return np.ascontiguousarray(np.moveaxis(t, 0, -1), dtype=np.float32)
+    rgba = table_rgba(model)
+    return np.ascontiguousarray(rgba[..., :3] * rgba[..., 3:])
 
 
 # --------------------------------------------------------------------------- file I/O
@@ -333,6 +341,7 @@ def save_merl(model: BRDF, path: str | os.PathLike) -> None:
 __all__ = [
     "MeasuredBRDF",
     "MERLBRDF",
+    "table_rgba",
     "load_merl",
     "save_merl",
     "tabulate",

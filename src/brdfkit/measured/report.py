@@ -8,22 +8,26 @@ Writes into DIR
   light, shaded with the measured and with the fitted BRDF (same exposure);
 * ``fit.json`` (the fit result) and ``index.md`` tying them together.
 
-The spheres are shaded in numpy (orthographic camera looking down −z, radiance
-``Σ f_r(wi, wo) · cos θi · E`` per light, exposure from the measured image's
-99.5th percentile, sRGB-like gamma 1/2.2).
+The spheres are shaded in numpy by :func:`brdfkit.analysis.plots.sphere_image`
+(orthographic camera on +z, radiance ``Σ f_r(wi, wo) · cos θi · E`` summed over
+the :data:`LIGHTS`), exposed so that the measured image's 99.5th percentile
+maps to 1 and encoded with the sRGB transfer curve
+(:func:`brdfkit.render.image.srgb_encode`).
 """
 
 from __future__ import annotations
 
 import json
+import math
 import os
 from typing import Any
 
 import numpy as np
 
-from ..geometry import frame_from_normal, normalize, spherical_to_vector, to_local
+from ..geometry import spherical_to_vector, vector_to_spherical
 
 SLICE_THETA_I_DEG = (20.0, 45.0, 70.0)
+#: (direction in camera space (+z toward the viewer), irradiance): a key light and a weaker fill
 LIGHTS = ((np.array([-0.55, 0.45, 0.70]), 1.0), (np.array([0.7, -0.2, 0.5]), 0.25))
 
 
@@ -36,27 +40,15 @@ def plane_slice(model, theta_i_deg: float, n: int = 361) -> tuple[np.ndarray, np
 
 
 def shade_sphere(model, size: int = 160) -> np.ndarray:
-    """Linear radiance image ``(size, size, 3)`` of a unit sphere (black background)."""
-    y, x = np.mgrid[1 : -1 : size * 1j, -1 : 1 : size * 1j]
-    r2 = x * x + y * y
-    inside = r2 < 1.0
-    n = np.stack([x[inside], y[inside], np.sqrt(1.0 - r2[inside])], axis=-1)
-    t, b = frame_from_normal(n)
-    view = np.broadcast_to(np.array([0.0, 0.0, 1.0]), n.shape)
-    wo = to_local(view, t, b, n)
+    """Linear radiance image ``(size, size, 3)`` of a unit sphere under :data:`LIGHTS` (black background)."""
+    from ..analysis.plots import sphere_image
+
     img = np.zeros((size, size, 3))
-    acc = np.zeros((n.shape[0], 3))
     for direction, power in LIGHTS:
-        L = np.broadcast_to(normalize(direction), n.shape)
-        wi = to_local(L, t, b, n)
-        f = np.asarray(model.eval(wi, wo), np.float64)
-        acc += f * np.maximum(wi[:, 2:3], 0.0) * power
-    img[inside] = acc
+        theta, phi = vector_to_spherical(direction)
+        one = sphere_image(model, math.degrees(theta), math.degrees(phi), size=size, exposure=power)
+        img += np.nan_to_num(one)  # background NaN -> black
     return img
-
-
-def _tonemap(img: np.ndarray, exposure: float) -> np.ndarray:
-    return np.clip(img * exposure, 0.0, 1.0) ** (1 / 2.2)
 
 
 def write_report(result, measured, out_dir: str) -> dict[str, Any]:
@@ -66,11 +58,13 @@ def write_report(result, measured, out_dir: str) -> dict[str, Any]:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    from ..render.image import srgb_encode
+
     os.makedirs(out_dir, exist_ok=True)
     fitted = result.model
     colors = ("tab:red", "tab:green", "tab:blue")
 
-    # -- polar slices -------------------------------------------------------------
+    # -- in-plane slices ---------------------------------------------------------
     fig, axes = plt.subplots(1, len(SLICE_THETA_I_DEG), figsize=(4.2 * len(SLICE_THETA_I_DEG), 3.8), dpi=100)
     for ax, ti in zip(np.atleast_1d(axes), SLICE_THETA_I_DEG):
         th, fm = plane_slice(measured, ti)
@@ -99,7 +93,7 @@ def write_report(result, measured, out_dir: str) -> dict[str, Any]:
     exposure = 1.0 / ref if ref > 0 else 1.0
     fig, axes = plt.subplots(1, 2, figsize=(7, 3.8), dpi=100)
     for ax, im, title in zip(axes, (im_m, im_f), ("measured: " + result.source, f"fitted: {fitted.name}")):
-        ax.imshow(_tonemap(im, exposure), interpolation="nearest")
+        ax.imshow(srgb_encode(im * exposure), interpolation="nearest")
         ax.set_title(title, fontsize=10)
         ax.axis("off")
     fig.tight_layout()
@@ -123,5 +117,5 @@ def write_report(result, measured, out_dir: str) -> dict[str, Any]:
             elif isinstance(v, float):
                 v = f"{v:.4g}"
             fh.write(f"| {k} | {v} |\n")
-        fh.write("\n![polar slices](slices.png)\n\n![spheres](spheres.png)\n")
+        fh.write("\n![in-plane slices](slices.png)\n\n![spheres](spheres.png)\n")
     return {"index": index, "slices": slices, "spheres": spheres, "json": js}

@@ -266,12 +266,9 @@ def table_key(model: Any) -> str:
 
 @lru_cache(maxsize=2)
 def _texels_cached(key: str, model_ref: Any) -> np.ndarray:
-    from ..measured.merl import tabulate
+    from ..measured.merl import table_rgba
 
-    t = tabulate(model_ref.model)  # (3, 90, 90, 180), negative = missing
-    out = np.empty(t.shape[1:] + (4,), dtype=np.float32)
-    out[..., :3] = np.moveaxis(np.maximum(t, 0.0), 0, -1)
-    out[..., 3] = (t >= 0).all(axis=0)
+    out = table_rgba(model_ref.model)
     out.setflags(write=False)
     return out
 
