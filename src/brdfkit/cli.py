@@ -44,10 +44,6 @@ for _mod in _PLUGINS:
     importlib.import_module(_mod).register(app)
 
 
-class CLIError(Exception):
-    """An error whose message is the whole story (printed as one line)."""
-
-
 def _one_line(exc: BaseException) -> str:
     msg = str(exc).strip().splitlines()
     return msg[0] if msg else type(exc).__name__
@@ -75,7 +71,7 @@ def main(argv: list[str] | None = None) -> int:
     except SystemExit as e:
         code = e.code
         return code if isinstance(code, int) else (0 if code is None else 1)
-    except (ValueError, OSError, CLIError, KeyError) as e:
+    except (ValueError, OSError, KeyError) as e:
         typer.echo(f"brdfkit: error: {_one_line(e)}", err=True)
         return 2
     except typer.Abort:
