@@ -26,12 +26,59 @@ and what is allowed.
 from __future__ import annotations
 
 import math
+import sys
 from dataclasses import dataclass
 from typing import Any, Iterable, Mapping, Sequence
 
 import numpy as np
 
 KINDS = ("scalar", "rgb", "choice", "bool", "int")
+
+
+def to_float(value: Any, what: str, *, finite: bool = True) -> float:
+    """The one number parser: ``value`` (a Python/numpy number or numeric text) as a float.
+
+    Every failure is a one-line ``ValueError`` naming ``what``: text that is not
+    a number, booleans, containers, integers too large for a float
+    (``10**400``, which ``float()`` answers with ``OverflowError``), text that
+    overflows (``"1e400"``, which ``float()`` silently turns into ``inf``) and,
+    with ``finite`` (the default), NaN and infinities.
+    """
+    if isinstance(value, (bool, np.bool_)) or value is None:
+        raise ValueError(f"{what} must be a number, got {value!r}")
+    if isinstance(value, bytes):
+        raise ValueError(f"{what} must be a number, got {value!r}")
+    if isinstance(value, str):
+        text = value.strip()
+        if len(text) > 400:
+            raise ValueError(f"{what} must be a number, got a {len(text)}-character text")
+        try:
+            f = float(text)
+        except ValueError:
+            raise ValueError(f"{what} must be a number, got {value!r}") from None
+        if finite and not math.isfinite(f):
+            low = text.lower().lstrip("+-")
+            if low in ("inf", "infinity", "nan"):
+                raise ValueError(f"{what} must be finite, got {value!r}")
+            raise ValueError(f"{what} = {value!r} overflows a float (largest {sys.float_info.max:.4g})")
+        return f
+    if not isinstance(value, (int, float, np.number)) and np.ndim(value) != 0:
+        raise ValueError(f"{what} must be a single number, got {_short(value)}")
+    try:
+        f = float(value)
+    except OverflowError:
+        raise ValueError(f"{what} = {_short(value)} overflows a float (largest {sys.float_info.max:.4g})") from None
+    except (TypeError, ValueError):
+        raise ValueError(f"{what} must be a number, got {_short(value)}") from None
+    if finite and not math.isfinite(f):
+        raise ValueError(f"{what} must be finite, got {_short(value)}")
+    return f
+
+
+def _short(value: Any) -> str:
+    """``repr(value)``, cut to 60 characters (a 400-digit integer must not fill the screen)."""
+    r = repr(value)
+    return r if len(r) <= 60 else f"{r[:40]}... ({len(r)} characters)"
 
 
 @dataclass(frozen=True)
@@ -140,12 +187,9 @@ class Param:
                 f"{model}: parameter '{self.name}' must be one of {', '.join(self.choices)}; got {value!r}"
             )
         if k == "int":
-            try:
-                f = float(value)
-            except (TypeError, ValueError):
-                raise ValueError(f"{model}: parameter '{self.name}' must be an integer, got {value!r}") from None
+            f = to_float(value, f"{model}: parameter '{self.name}'", finite=False)
             if not math.isfinite(f) or f != int(f):
-                raise ValueError(f"{model}: parameter '{self.name}' must be an integer, got {value!r}")
+                raise ValueError(f"{model}: parameter '{self.name}' must be an integer, got {_short(value)}")
             self._check_number(model, f, "")
             return int(f)
         if k == "scalar":
@@ -154,21 +198,31 @@ class Param:
             arr = np.asarray(value, dtype=object)
             if arr.ndim != 0:
                 raise ValueError(f"{model}: parameter '{self.name}' must be a single number, got {value!r}")
-            try:
-                f = float(value)
-            except (TypeError, ValueError):
-                raise ValueError(f"{model}: parameter '{self.name}' must be a number, got {value!r}") from None
+            f = to_float(value, f"{model}: parameter '{self.name}'", finite=False)
             self._check_number(model, f, "")
             return f
         # rgb
         if isinstance(value, (str, bytes)) or isinstance(value, bool):
             raise ValueError(f"{model}: parameter '{self.name}' must be a number or an RGB triple, got {value!r}")
-        try:
-            arr = np.asarray(value, dtype=np.float64)
-        except (TypeError, ValueError):
-            raise ValueError(
-                f"{model}: parameter '{self.name}' must be a number or an RGB triple, got {value!r}"
-            ) from None
+        what = f"{model}: parameter '{self.name}'"
+        if isinstance(value, (int, float, np.number)):
+            arr = np.asarray(to_float(value, what, finite=False))
+        else:
+            try:
+                obj = np.asarray(value, dtype=object)
+            except (TypeError, ValueError):
+                obj = np.asarray(None, dtype=object)
+            if obj.shape != (3,) and obj.ndim != 0:
+                raise ValueError(
+                    f"{model}: parameter '{self.name}' must be a number or an RGB triple, got shape {obj.shape}"
+                )
+            if obj.ndim == 0 and not isinstance(obj.item(), (int, float, np.number)):
+                raise ValueError(
+                    f"{model}: parameter '{self.name}' must be a number or an RGB triple, got {_short(value)}"
+                )
+            vals = [to_float(v, what if obj.ndim == 0 else f"{what}[{'rgb'[i]}]", finite=False)
+                    for i, v in enumerate(obj.reshape(-1))]
+            arr = np.asarray(vals[0]) if obj.ndim == 0 else np.array(vals, dtype=np.float64)
         if arr.ndim == 0:
             arr = np.full(3, float(arr))
         elif arr.shape != (3,):
@@ -220,10 +274,12 @@ def parse_value(model: str, param: Param, text: str) -> Any:
     if param.kind == "rgb":
         parts = [t for t in text.split(",")]
         try:
-            nums = [float(t) for t in parts]
-        except ValueError:
+            nums = [to_float(t, f"{model}: parameter '{param.name}'") for t in parts]
+        except ValueError as e:
+            if "overflows" in str(e) or "finite" in str(e):
+                raise
             raise ValueError(
-                f"{model}: parameter '{param.name}' expects a number or r,g,b; got {text!r}"
+                f"{model}: parameter '{param.name}' expects a number or r,g,b; got {_short(text)}"
             ) from None
         if len(nums) == 1:
             return param.validate(model, nums[0])
@@ -231,9 +287,11 @@ def parse_value(model: str, param: Param, text: str) -> Any:
             raise ValueError(f"{model}: parameter '{param.name}' expects 1 or 3 numbers, got {len(nums)}")
         return param.validate(model, nums)
     try:
-        num = float(text)
-    except ValueError:
-        raise ValueError(f"{model}: parameter '{param.name}' expects a number; got {text!r}") from None
+        num = to_float(text, f"{model}: parameter '{param.name}'")
+    except ValueError as e:
+        if "overflows" in str(e) or "finite" in str(e):
+            raise
+        raise ValueError(f"{model}: parameter '{param.name}' expects a number; got {_short(text)}") from None
     return param.validate(model, num)
 
 
@@ -249,6 +307,8 @@ def parse_assignments(model: str, spec: ParamSpec, items: Iterable[str]) -> dict
         if name not in by_name:
             valid = ", ".join(by_name) or "(none)"
             raise ValueError(f"{model}: unknown parameter '{name}'; valid parameters: {valid}")
+        if name in out:
+            raise ValueError(f"{model}: parameter '{name}' given twice (-p {name}=...); give it once")
         out[name] = parse_value(model, by_name[name], text)
     return out
 
@@ -281,6 +341,7 @@ def exponent_param(name: str, default: float, doc: str) -> Param:
 
 
 __all__ = [
+    "to_float",
     "Param",
     "ParamSpec",
     "validate",

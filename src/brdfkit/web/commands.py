@@ -12,11 +12,14 @@ def register(app: typer.Typer) -> None:
         host: str = typer.Option("127.0.0.1", "--host", help="address to bind (default: this machine only)"),
         no_browser: bool = typer.Option(False, "--no-browser", help="do not open a web browser"),
         verbose: bool = typer.Option(False, "--verbose", help="log every request to stderr"),
+        allow_host: list[str] = typer.Option(
+            [], "--allow-host", metavar="NAME", help="another name the Host header may carry (localhost names and IP literals always work); repeatable"
+        ),
     ) -> None:
         """Explore the models in a web browser: sliders, a lit sphere and a polar plot (WebGL 2)."""
         from . import server as web_server
 
-        srv = web_server.make_server(host, port)
+        srv = web_server.make_server(host, port, allowed_hosts=allow_host)
         web_server.Handler.quiet = not verbose
         url = srv.url
         typer.echo(f"brdfkit explorer at {url}  (Ctrl-C to stop)")
