@@ -64,6 +64,7 @@ def register(app: typer.Typer) -> None:
 
         from ..cli_common import model_from_cli
         from . import scene as sc
+        from ..fileio import check_output_path
         from .image import IMAGE_SUFFIXES
 
         obj: dict[str, Any] = sc.read_scene_file(scene) if scene is not None else {}
@@ -112,8 +113,7 @@ def register(app: typer.Typer) -> None:
             obj["srgb"] = srgb
         if material is not None:
             obj["material"] = material  # an object: scene_from_json takes it as it is
-        if output.suffix.lower() not in IMAGE_SUFFIXES:  # fail before rendering, as save_image would after
-            raise ValueError(f"output must end in {', '.join(IMAGE_SUFFIXES)}; got {str(output)!r}")
+        check_output_path(output, what="image", suffixes=IMAGE_SUFFIXES, notify=lambda m: typer.echo(m, err=True))
         # the look: the material's defaults, then the scene file's fields, then the flags (already in obj)
         parsed, look = sc.scene_from_json(obj, base_dir=base)
         t0 = time.perf_counter()

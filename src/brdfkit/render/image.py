@@ -22,7 +22,9 @@ Defaults differ by material, on purpose:
 
 :func:`save_image` writes 8-bit PNG (the display image) or EXR (the linear
 float image, premultiplied RGBA, no tone mapping, no background), chosen by
-the file's extension; ``.npy`` stores the linear float array.
+the file's extension; ``.npy`` stores the linear float array. Every file is
+written atomically (:mod:`brdfkit.fileio`: a temporary file beside it, then
+``os.replace``), so an interrupted write leaves the previous file whole.
 """
 
 from __future__ import annotations
@@ -31,6 +33,8 @@ import os
 from pathlib import Path
 
 import numpy as np
+
+from ..fileio import atomic_open, atomic_path
 
 TONEMAPS = ("clamp", "reinhard", "aces")
 
@@ -88,7 +92,8 @@ def save_png(path: str | os.PathLike, display: np.ndarray) -> None:
     mode = "RGBA" if img.shape[-1] == 4 else "RGB"
     if mode == "RGBA" and np.all(img[..., 3] == 255):
         img, mode = img[..., :3], "RGB"
-    Image.fromarray(np.ascontiguousarray(img), mode).save(os.fspath(path))
+    with atomic_open(path, "wb") as f:
+        Image.fromarray(np.ascontiguousarray(img), mode).save(f, format="PNG")
 
 
 def save_exr(path: str | os.PathLike, linear: np.ndarray) -> None:
@@ -101,13 +106,14 @@ def save_exr(path: str | os.PathLike, linear: np.ndarray) -> None:
     if OpenEXR is not None and hasattr(OpenEXR, "File"):
         channels = {"RGBA": lin}
         header = {"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineimage}
-        with OpenEXR.File(header, channels) as f:
-            f.write(os.fspath(path))
+        with atomic_path(path) as tmp, OpenEXR.File(header, channels) as f:
+            f.write(tmp)
         return
     try:  # pragma: no cover - fallback
         import imageio.v3 as iio
 
-        iio.imwrite(os.fspath(path), lin, extension=".exr")
+        with atomic_path(path) as tmp:
+            iio.imwrite(tmp, lin, extension=".exr")
     except Exception as e:  # pragma: no cover
         raise OSError(f"cannot write EXR {path}: install the OpenEXR package ({e})") from None
 
@@ -139,4 +145,10 @@ def save_image(path: str | os.PathLike, linear: np.ndarray, display: np.ndarray)
     elif suffix == ".exr":
         save_exr(path, linear)
     else:
-        np.save(os.fspath(path), np.asarray(linear, dtype=np.float32))
+        save_npy(path, linear)
+
+
+def save_npy(path: str | os.PathLike, linear: np.ndarray) -> None:
+    """The linear float image as float32 ``.npy``, written atomically."""
+    with atomic_open(path, "wb") as f:
+        np.save(f, np.asarray(linear, dtype=np.float32))

@@ -25,6 +25,15 @@ Every field is optional: the defaults are the teapot, the default camera
 directional light from the upper left (:data:`DEFAULT_LIGHTS`), OpenGL's
 light model, gold, Phong shading, an opaque black background, antialiasing.
 Relative mesh and MERL paths are resolved against the scene file's folder.
+
+A scene file is untrusted input: every field is checked before anything is
+built, and a bad one is a one-line ``ValueError`` that names it (``scene
+field 'size': ...``), which ``brdfkit render`` prints as ``brdfkit: error:``
+with exit status 2. Sizes are integers in [1, 8192]; the built-in meshes'
+tessellation options are bounded (:data:`brdfkit.render.meshes.TESSELLATION_LIMITS`);
+JSON nested deeper than :data:`MAX_DEPTH` is refused. The keys in
+:data:`OPEN_FIELDS` (``environment``) are accepted here and left to the
+code that renders them.
 Measured materials render through the GLSL backend too: their MERL table is
 a 3D texture (``shaders/measured.glsl``; a Neural-BRDF material is tabulated
 at the MERL bin centres first).
@@ -50,6 +59,13 @@ SCENE_FIELDS = (
     "mesh", "camera", "size", "lights", "light_model", "material", "shading",
     "background", "antialias", "tonemap", "exposure", "srgb",
 )
+OPEN_FIELDS = ("environment",)
+"""Scene keys this module accepts without interpreting them (image-based lighting reads ``environment``)."""
+
+MAX_DEPTH = 32
+"""Deepest JSON nesting a scene file may have (the deepest valid scene needs 4)."""
+
+MAX_SIZE = 8192
 
 DEFAULT_LIGHTS = (opengl.Light(position=(-1.0, 1.2, 1.5, 0.0), diffuse=(1, 1, 1), specular=(1, 1, 1)),)
 """One white directional light from the upper left, in front (eye space)."""
@@ -66,10 +82,11 @@ class Look:
     def __post_init__(self) -> None:
         if self.tonemap not in TONEMAPS:
             raise ValueError(f"tonemap must be one of {', '.join(TONEMAPS)}; got {self.tonemap!r}")
-        try:
-            self.exposure = float(self.exposure)
-        except (TypeError, ValueError):
-            raise ValueError(f"exposure must be a positive number, got {self.exposure!r}") from None
+        from ..params import to_float
+
+        if not isinstance(self.tonemap, str) or self.tonemap not in TONEMAPS:
+            raise ValueError(f"tonemap must be one of {', '.join(TONEMAPS)}; got {self.tonemap!r}")
+        self.exposure = to_float(self.exposure, "exposure")
         if not np.isfinite(self.exposure) or self.exposure <= 0:
             raise ValueError(f"exposure must be a positive number, got {self.exposure!r}")
         if not isinstance(self.srgb, (bool, np.bool_)):
@@ -125,7 +142,11 @@ def material_from_spec(spec: Any) -> Any:
         from .. import measured
 
         if "measured" in spec:
+            if not isinstance(spec["measured"], str):
+                raise ValueError(f"material 'measured' must be a material name (a string), got {spec['measured']!r}")
             return measured.material(spec["measured"])
+        if not isinstance(spec["merl"], (str, os.PathLike)) or not str(spec["merl"]):
+            raise ValueError(f"material 'merl' must be a file name (a string), got {spec['merl']!r}")
         return measured.load_merl(spec["merl"])
     if "model" in spec:
         extra = set(spec) - {"model", "params"}
@@ -134,27 +155,133 @@ def material_from_spec(spec: Any) -> Any:
         import brdfkit as bk
 
         params = spec.get("params", {}) or {}
+        if not isinstance(spec["model"], str):
+            raise ValueError(f"material 'model' must be a model name (a string), got {spec['model']!r}")
         if not isinstance(params, Mapping):
             raise ValueError("material params must be an object of name: value")
-        return bk.model(spec["model"], **dict(params))
+        return bk.model(spec["model"], **{str(k): v for k, v in params.items()})
     raise ValueError(_MATERIAL_FORMS)
 
 
 def _size(value: Any) -> tuple[int, int]:
+    """``[width, height]``: two integers in [1, :data:`MAX_SIZE`] (1e400, 0, 64.5, true and "64" are errors)."""
+    from ..params import to_float
+
+    if isinstance(value, (str, bytes, Mapping)) or not hasattr(value, "__len__") or len(value) != 2:
+        raise ValueError(f"size must be [width, height] (two integers), got {_short(value)}")
+    out = []
+    for name, x in zip(("width", "height"), value):
+        if isinstance(x, str):
+            raise ValueError(f"size {name} must be an integer, got {x!r}")
+        f = to_float(x, f"size {name}")
+        if f != int(f):
+            raise ValueError(f"size {name} must be an integer, got {x!r}")
+        if not 1 <= f <= MAX_SIZE:
+            raise ValueError(f"size {name} must be in [1, {MAX_SIZE}], got {int(f)}")
+        out.append(int(f))
+    return out[0], out[1]
+
+
+def _short(value: Any) -> str:
+    r = repr(value)
+    return r if len(r) <= 80 else r[:60] + f"... ({len(r)} characters)"
+
+
+def _numbers(value: Any, what: str, sizes: tuple[int, ...]) -> None:
+    """Check that ``value`` is a finite number (if 1 in ``sizes``) or a list of finite numbers of one of ``sizes``."""
+    from ..params import to_float
+
+    if isinstance(value, (list, tuple)):
+        if len(value) not in sizes or any(isinstance(x, (list, tuple, dict, str)) for x in value):
+            raise ValueError(f"{what} must be a list of {' or '.join(str(n) for n in sizes if n > 1)} numbers, got {_short(value)}")
+        for x in value:
+            to_float(x, what)
+        return
+    if 1 not in sizes:
+        raise ValueError(f"{what} must be a list of {' or '.join(str(n) for n in sizes)} numbers, got {_short(value)}")
+    to_float(value, what)
+
+
+def _check_object(obj: Any, what: str, bools: tuple[str, ...] = ()) -> None:
+    """An OpenGL light / light model / material object: every field a finite number or list of numbers
+    (or a boolean for the names in ``bools``); unknown names are left to :mod:`brdfkit.opengl`."""
+    if not isinstance(obj, Mapping):
+        raise ValueError(f"{what} must be an object, got {type(obj).__name__}")
+    for k, v in obj.items():
+        if k in bools:
+            if not isinstance(v, bool):
+                raise ValueError(f"{what} field '{k}' must be true or false, got {_short(v)}")
+        else:
+            _numbers(v, f"{what} field '{k}'", (1, 3, 4))
+
+
+def _field(name: str, fn, *args):
+    """``fn(*args)`` with its ``ValueError`` prefixed by the scene field it concerns."""
     try:
-        w, h = (int(x) for x in value)
-    except (TypeError, ValueError):
-        raise ValueError(f"size must be [width, height], got {value!r}") from None
-    return w, h
+        return fn(*args)
+    except ValueError as e:
+        msg = str(e).strip().splitlines()[0] if str(e).strip() else type(e).__name__
+        raise ValueError(f"scene field '{name}': {msg}") from None
+    except (TypeError, OverflowError, RecursionError) as e:  # a type no check above foresaw: still one line
+        raise ValueError(f"scene field '{name}': invalid value ({type(e).__name__}: {e})") from None
+
+
+def _check_fields(obj: Mapping[str, Any]) -> None:
+    """Type checks of a scene object's fields (before anything is built)."""
+    if "camera" in obj and obj["camera"] is not None and not isinstance(obj["camera"], Mapping):
+        raise ValueError(
+            f"scene field 'camera': must be an object ({{\"eye\": [x,y,z], ...}} or {{\"projection\", \"modelview\"}}), got {type(obj['camera']).__name__}"
+        )
+    if isinstance(obj.get("camera"), Mapping):
+        for k, v in obj["camera"].items():
+            if k in ("projection", "modelview"):
+                if not isinstance(v, (list, tuple)) or len(v) != 4:
+                    raise ValueError(f"scene field 'camera': {k} must be a 4x4 matrix (list of 4 rows)")
+                for row in v:
+                    _field("camera", _numbers, row, f"camera {k} row", (4,))
+            else:
+                _field("camera", _numbers, v, f"camera {k}", (1, 3))
+    if "size" in obj:
+        _field("size", _size, obj["size"])
+    if "background" in obj:
+        _field("background", _numbers, obj["background"], "background", (3, 4))
+    if "lights" in obj and obj["lights"] is not None:
+        if not isinstance(obj["lights"], (list, tuple)):
+            raise ValueError("scene field 'lights': must be a list of light objects")
+        for i, L in enumerate(obj["lights"]):
+            _field("lights", _check_object, L, f"light {i}")
+    if obj.get("light_model") is not None:
+        _field("light_model", _check_object, obj["light_model"], "light_model", ("local_viewer",))
+    for k in ("shading", "tonemap"):
+        if k in obj and not isinstance(obj[k], str):
+            raise ValueError(f"scene field '{k}': must be a name (a string), got {_short(obj[k])}")
+    for k in ("antialias", "srgb"):
+        if k in obj and not isinstance(obj[k], bool):
+            raise ValueError(f"scene field '{k}': must be true or false, got {_short(obj[k])}")
+    mat = obj.get("material")
+    if isinstance(mat, Mapping) and isinstance(mat.get("opengl"), Mapping):
+        _field("material", _check_object, mat["opengl"], "opengl material")
+    mesh = obj.get("mesh")
+    if mesh is not None and not isinstance(mesh, (str, Mapping, Mesh)):
+        raise ValueError(
+            f"scene field 'mesh': must be a built-in name ({', '.join(BUILTIN)}), a file path, or an object with 'builtin' or 'path'; got {_short(mesh)}"
+        )
+    if isinstance(mesh, Mapping) and "path" in mesh and not isinstance(mesh["path"], str):
+        raise ValueError(f"scene field 'mesh': 'path' must be a file name (a string), got {_short(mesh['path'])}")
+    if isinstance(mat, Mapping) and "merl" in mat and not isinstance(mat["merl"], str):
+        raise ValueError(f"scene field 'material': 'merl' must be a file name (a string), got {_short(mat['merl'])}")
 
 
 def scene_from_json(obj: Mapping[str, Any], base_dir: str | os.PathLike | None = None) -> tuple[Scene, Look]:
     """A :class:`Scene` and its :class:`Look` from a scene file's object."""
     if not isinstance(obj, Mapping):
         raise ValueError("a scene must be a JSON object")
-    extra = set(obj) - set(SCENE_FIELDS)
+    extra = set(obj) - set(SCENE_FIELDS) - set(OPEN_FIELDS)
     if extra:
-        raise ValueError(f"scene: unknown field(s) {', '.join(sorted(extra))}; valid fields: {', '.join(SCENE_FIELDS)}")
+        raise ValueError(
+            f"scene: unknown field(s) {', '.join(sorted(map(str, extra)))}; valid fields: {', '.join(SCENE_FIELDS + OPEN_FIELDS)}"
+        )
+    _check_fields(obj)
     mesh_spec = obj.get("mesh", "teapot")
     if isinstance(mesh_spec, str) and mesh_spec not in BUILTIN and base_dir is not None and not os.path.isabs(mesh_spec):
         mesh_spec = os.path.join(os.fspath(base_dir), mesh_spec)
@@ -167,8 +294,8 @@ def scene_from_json(obj: Mapping[str, Any], base_dir: str | os.PathLike | None =
         if not os.path.isabs(mat_spec["merl"]):
             mat_spec = {"merl": os.path.join(os.fspath(base_dir), mat_spec["merl"])}
     scene = make_scene(
-        mesh=mesh_from_spec(mesh_spec),
-        material=mat_spec,
+        mesh=_field("mesh", mesh_from_spec, mesh_spec),
+        material=_field("material", material_from_spec, mat_spec),
         shading=obj.get("shading", "phong"),
         size=obj.get("size", (512, 512)),
         camera=obj.get("camera"),
@@ -178,7 +305,7 @@ def scene_from_json(obj: Mapping[str, Any], base_dir: str | os.PathLike | None =
         antialias=obj.get("antialias", True),
     )
     look = default_look(scene.material)
-    look = Look(
+    look = Look(  # its errors name tonemap, exposure or srgb
         obj.get("tonemap", look.tonemap),
         obj.get("exposure", look.exposure),
         obj.get("srgb", look.srgb),
@@ -191,13 +318,45 @@ def read_scene_file(path: str | os.PathLike) -> dict[str, Any]:
     p = Path(path)
     if not p.is_file():
         raise OSError(f"scene file not found: {p}")
+    if p.stat().st_size > 16 << 20:
+        raise ValueError(f"scene file {p} is larger than 16 MiB; a scene names its mesh files instead of holding them")
     try:
-        obj = json.loads(p.read_text(encoding="utf-8"))
+        text = p.read_bytes().decode("utf-8")
+    except UnicodeDecodeError as e:
+        raise ValueError(f"scene file {p} is not UTF-8 text (byte {e.start})") from None
+    if _too_deep(text, MAX_DEPTH):
+        raise ValueError(f"scene file {p} nests JSON deeper than {MAX_DEPTH} levels")
+    try:
+        obj = json.loads(text)
     except json.JSONDecodeError as e:
         raise ValueError(f"scene file {p} is not valid JSON: {e.msg} (line {e.lineno})") from None
+    except (RecursionError, ValueError) as e:  # e.g. an integer of more than 4300 digits
+        raise ValueError(f"scene file {p} is not valid JSON: {str(e).splitlines()[0] if str(e) else type(e).__name__}") from None
     if not isinstance(obj, dict):
         raise ValueError("a scene must be a JSON object")
     return obj
+
+
+def _too_deep(text: str, limit: int) -> bool:
+    """Whether the brackets of JSON ``text`` nest deeper than ``limit`` (strings skipped)."""
+    depth, in_str, esc = 0, False, False
+    for ch in text:
+        if in_str:
+            if esc:
+                esc = False
+            elif ch == "\\":
+                esc = True
+            elif ch == '"':
+                in_str = False
+        elif ch == '"':
+            in_str = True
+        elif ch in "[{":
+            depth += 1
+            if depth > limit:
+                return True
+        elif ch in "]}":
+            depth -= 1
+    return False
 
 
 def load_scene(path: str | os.PathLike) -> tuple[Scene, Look]:
@@ -217,27 +376,29 @@ def make_scene(
     antialias: bool = True,
 ) -> Scene:
     """A :class:`Scene` from friendly arguments (names or objects); the scene-file fields, by keyword."""
-    w, h = _size(size)
-    if h <= 0:
-        raise ValueError(f"size must be positive, got {(w, h)}")
-    m = mesh if isinstance(mesh, Mesh) else mesh_from_spec(mesh)
-    projection, modelview = camera_matrices(camera, w / h)
+    w, h = _field("size", _size, size)
+    m = mesh if isinstance(mesh, Mesh) else _field("mesh", mesh_from_spec, mesh)
+    if camera is not None and not isinstance(camera, Mapping):
+        raise ValueError(f"scene field 'camera': must be an object, got {type(camera).__name__}")
+    projection, modelview = _field("camera", camera_matrices, camera, w / h)
     if lights is None:
         ls = list(DEFAULT_LIGHTS)
     elif not isinstance(lights, (list, tuple)):
         raise ValueError("lights must be a list of light objects")
     else:
-        ls = [opengl.light_from_json(L) for L in lights]
+        ls = [_field("lights", opengl.light_from_json, L) for L in lights]
     if not isinstance(antialias, bool):
         raise ValueError(f"antialias must be true or false, got {antialias!r}")
+    if isinstance(background, (str, bytes, Mapping)) or not hasattr(background, "__len__"):
+        raise ValueError(f"scene field 'background': must be r,g,b or r,g,b,a in [0, 1], got {_short(background)}")
     return Scene(
         mesh=m,
         projection=projection,
         modelview=modelview,
         size=(w, h),
         lights=ls,
-        light_model=opengl.light_model_from_json(light_model),
-        material=material_from_spec(material),
+        light_model=_field("light_model", opengl.light_model_from_json, light_model),
+        material=_field("material", material_from_spec, material),
         shading=shading,
         background=tuple(background),
         antialias=antialias,
