@@ -26,8 +26,20 @@ app = typer.Typer(
 )
 
 
+def _show_version(value: bool) -> None:
+    if value:
+        from . import __version__
+
+        typer.echo(f"brdfkit {__version__}")
+        raise typer.Exit(0)
+
+
 @app.callback()
-def _root() -> None:
+def _root(
+    version: bool = typer.Option(
+        False, "--version", is_eager=True, callback=_show_version, help="Print brdfkit's version and exit."
+    ),
+) -> None:
     """brdfkit: every BRDF of the classic lecture, exact, checked, rendered, fitted."""
 
 

@@ -105,6 +105,40 @@ def eval_result(m: Any, wi: np.ndarray, wo: np.ndarray) -> dict[str, Any]:
     }
 
 
+def measured_info(name: str, m: Any) -> dict[str, Any]:
+    """What ``brdfkit info`` shows for a measured material (a built-in name or a MERL file)."""
+    kind = type(m).__name__
+    title = {
+        "NeuralBRDF": "built-in measured material (Neural-BRDF network trained on the measurement)",
+        "MERLBRDF": "measured material from a MERL .binary table (90 x 90 x 180 bins)",
+    }.get(kind, "measured material")
+    return {
+        "name": getattr(m, "label", None) or name,
+        "title": title,
+        "kind": kind,
+        "source": getattr(m, "source", "") or getattr(m, "label", None) or name,
+        "isotropic": True,
+        "params": [],
+    }
+
+
+def _measured_info(name: str, m: Any, json_: bool) -> None:
+    data = measured_info(name, m)
+    if json_:
+        print_json(data)
+        return
+    con = _console()
+    con.print(f"{data['name']}: {data['title']} (isotropic)", markup=False, soft_wrap=True)
+    if data["source"] != data["name"]:
+        con.print(f"Source: {data['source']}", markup=False, soft_wrap=True)
+    con.print(
+        f"Measured data has no parameters. Use it wherever a model is taken, e.g. "
+        f"brdfkit eval {name} --wi 30,0 --wo 30,180; brdfkit list --measured lists the built-in ones.",
+        markup=False,
+        soft_wrap=True,
+    )
+
+
 def register(app: typer.Typer) -> None:
     @app.command("list")
     def list_models(
@@ -137,9 +171,15 @@ def register(app: typer.Typer) -> None:
         model: str = typer.Argument(..., metavar="MODEL", help="Registry name (see `brdfkit list`)."),
         json_: bool = typer.Option(False, "--json", help="Print the model info as JSON."),
     ) -> None:
-        """Show a model's title, reference and parameter table."""
+        """Show a model's title, reference and parameter table (or what a measured material is)."""
         import brdfkit as bk
 
+        if model not in bk.models():
+            from .cli_common import _measured_from_cli
+
+            measured = _measured_from_cli(model, [])
+            if measured is not None:
+                return _measured_info(model, measured, json_)
         data = bk.model_info(model)
         if json_:
             print_json(data)

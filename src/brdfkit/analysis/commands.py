@@ -67,6 +67,11 @@ def _table(results: list[dict[str, Any]]) -> None:
     Console(width=max(150, int(os.environ.get("COLUMNS", "0") or 0))).print(t)
 
 
+def _note(message: str) -> None:
+    """Tell the user (stderr) what was done on their behalf, e.g. a created output folder."""
+    typer.echo(f"brdfkit: {message}", err=True)
+
+
 def register(app: typer.Typer) -> None:
     @app.command("check")
     def check_cmd(
@@ -98,11 +103,11 @@ def register(app: typer.Typer) -> None:
         elif plot_path is not None:
             raise ValueError("check: --plot goes with --all")
         if all_models:
-            if plot_path is not None:
+            if plot_path is not None:  # before the work: a bad path must not cost the whole run
+                from ..fileio import check_output_path
                 from .plots import FORMATS
 
-                if not plot_path.lower().endswith(FORMATS):
-                    raise ValueError(f"check: --plot must end in {', '.join(FORMATS)}, got {plot_path!r}")
+                check_output_path(plot_path, what="check --plot", suffixes=FORMATS, notify=_note)
             results = _run_all(level or "fast", jobs, quiet=json_out)
             if plot_path is not None:
                 from .plots import save_figure, verdict_table_figure
@@ -179,6 +184,14 @@ def register(app: typer.Typer) -> None:
             raise ValueError(f"plot: --exposure must be positive, got {exposure:g}")
         if not 16 <= size <= 4096:
             raise ValueError(f"plot: --size must lie in [16, 4096], got {size}")
+        if not 0.0 <= phi_d <= 360.0:
+            raise ValueError(f"plot: --phi-d must lie in [0, 360] degrees, got {phi_d:g}")
+        if kind in ("polar", "lobe") and not 0.0 <= theta_i <= 90.0:
+            raise ValueError(f"plot: --theta-i must lie in [0, 90] degrees, got {theta_i:g}")
+        from ..fileio import check_output_path
+        from .plots import FORMATS
+
+        check_output_path(output, what="plot", suffixes=FORMATS, notify=_note)
         models = [model_from_cli(n, items) for n, items in parse_model_groups(spec)]
         opts: dict[str, Any] = {"log": log}
         if kind == "polar":

@@ -55,9 +55,13 @@ def label(model: Any, width: int | None = None) -> str:
     """``name(k=v, ...)`` with every parameter in effect (:meth:`BRDF.active_params`), for legends and titles."""
     active = getattr(model, "active_params", None)
     params = active() if callable(active) else (getattr(model, "params", {}) or {})
-    text = f"{getattr(model, 'name', type(model).__name__)}(" + ", ".join(
-        f"{k}={_fmt_value(v)}" for k, v in params.items()
-    ) + ")"
+    own = getattr(model, "label", None)  # measured data: its material name ("merl/chrome"), not "nbrdf()"
+    if isinstance(own, str) and own and not params:
+        text = own
+    else:
+        text = f"{getattr(model, 'name', type(model).__name__)}(" + ", ".join(
+            f"{k}={_fmt_value(v)}" for k, v in params.items()
+        ) + ")"
     if width:
         text = "\n".join(textwrap.wrap(text, width, subsequent_indent="  "))
     return text
@@ -468,8 +472,11 @@ def save_figure(fig, path: str | Path, dpi: int = 150) -> Path:
     ext = p.suffix.lower()
     if ext not in FORMATS:
         raise ValueError(f"plot: output must end in {', '.join(FORMATS)}, got {p.name!r}")
+    from ..fileio import atomic_path
+
     FigureCanvasAgg(fig)
-    fig.savefig(p, dpi=dpi, format=ext[1:])
+    with atomic_path(p) as tmp:  # a killed write leaves the previous file whole
+        fig.savefig(tmp, dpi=dpi, format=ext[1:])
     return p
 
 

@@ -65,14 +65,16 @@ def write_batch(results, models: list[str], sources: list[str], out_dir: str, me
     os.makedirs(out_dir, exist_ok=True)
     table = {(r.source, r.model.name): r for r in results}
     csv_path = os.path.join(out_dir, "fit_errors.csv")
-    with open(csv_path, "w") as fh:
+    from ..fileio import atomic_open, atomic_path
+
+    with atomic_open(csv_path, "w") as fh:
         fh.write("material," + ",".join(models) + "\n")
         for s in sources:
             fh.write(s + "," + ",".join(f"{table[(s, m)].error:.6g}" for m in models) + "\n")
     md_path = os.path.join(out_dir, "fit_errors.md")
     errs = np.array([[table[(s, m)].error for m in models] for s in sources])
     best = errs.argmin(axis=1)
-    with open(md_path, "w") as fh:
+    with atomic_open(md_path, "w") as fh:
         fh.write(f"Fitting error per material and model; metric: {metric}. Best per row in bold.\n\n")
         fh.write("| material | " + " | ".join(models) + " |\n")
         fh.write("|---|" + "---:|" * len(models) + "\n")
@@ -94,10 +96,11 @@ def write_batch(results, models: list[str], sources: list[str], out_dir: str, me
     ax.grid(True, which="both", alpha=0.3)
     ax.legend()
     fig.tight_layout()
-    fig.savefig(png_path)
+    with atomic_path(png_path) as tmp:
+        fig.savefig(tmp, format="png")
     plt.close(fig)
     json_path = os.path.join(out_dir, "fit_params.json")
-    with open(json_path, "w") as fh:
+    with atomic_open(json_path, "w") as fh:
         json.dump([r.to_json() for r in results], fh, indent=1)
     return {"csv": csv_path, "markdown": md_path, "plot": png_path, "params": json_path}
 
@@ -131,6 +134,13 @@ def register(app: typer.Typer) -> None:
             raise ValueError("missing --model NAME; valid models: " + ", ".join(registry.names()))
         for m in model:
             registry.get(m)
+        from ..fileio import check_output_path  # output folders checked before the fitting starts
+
+        _note = lambda msg: typer.echo(f"brdfkit: {msg}", err=True)  # noqa: E731
+        if all_measured:
+            check_output_path(out, what="--out", is_dir=True, notify=_note)
+        elif report:
+            check_output_path(report, what="--report", is_dir=True, notify=_note)
         if all_measured:
             if source is not None:
                 raise ValueError("give either SOURCE or --all-measured, not both")

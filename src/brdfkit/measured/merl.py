@@ -328,13 +328,22 @@ def write_merl_table(table, path: str | os.PathLike) -> None:
         raise ValueError(f"MERL table must have shape (3, 90, 90, 180), got {table.shape}")
     raw = table / SCALES[:, None, None, None]
     raw = np.where(np.isfinite(raw) & (table >= 0), raw, MISSING)
-    with open(os.fspath(path), "wb") as fh:
+    from ..fileio import atomic_open
+
+    with atomic_open(path, "wb") as fh:  # temp file + os.replace: a killed write keeps the old file
         fh.write(np.asarray(SHAPE, dtype="<i4").tobytes())
         fh.write(np.ascontiguousarray(raw, dtype="<f8").tobytes())
 
 
 def save_merl(model: BRDF, path: str | os.PathLike) -> None:
-    """Tabulate an isotropic model at the bin centres and write it as a MERL ``.binary`` file."""
+    """Tabulate an isotropic model at the bin centres and write it as a MERL ``.binary`` file.
+
+    The path is checked before the tabulation (a missing folder, a folder given as the file:
+    a one-line ``ValueError`` at once), and the file is written atomically.
+    """
+    from ..fileio import check_output_path
+
+    check_output_path(path, what="MERL file")
     write_merl_table(tabulate(model), path)
 
 

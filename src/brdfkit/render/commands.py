@@ -113,7 +113,7 @@ def register(app: typer.Typer) -> None:
             obj["srgb"] = srgb
         if material is not None:
             obj["material"] = material  # an object: scene_from_json takes it as it is
-        check_output_path(output, what="image", suffixes=IMAGE_SUFFIXES, notify=lambda m: typer.echo(m, err=True))
+        check_output_path(output, what="image", suffixes=IMAGE_SUFFIXES, notify=lambda m: typer.echo(f"brdfkit: {m}", err=True))
         # the look: the material's defaults, then the scene file's fields, then the flags (already in obj)
         parsed, look = sc.scene_from_json(obj, base_dir=base)
         t0 = time.perf_counter()
@@ -152,6 +152,9 @@ def register(app: typer.Typer) -> None:
         for n in names:
             if n not in FIGURES:
                 raise ValueError(f"unknown figure {n!r}; valid figures: {', '.join(FIGURES)}")
+        from ..fileio import check_output_path
+
+        check_output_path(out_dir, what="gallery", is_dir=True, notify=lambda m: typer.echo(f"brdfkit: {m}", err=True))
         written = run_gallery(out_dir, names, size=size, progress=not as_json)
         if as_json:
             typer.echo(json.dumps([str(p) for p in written]))
