@@ -242,3 +242,20 @@ def test_save_merl_checks_the_path_before_tabulating(tmp_path, monkeypatch):
     monkeypatch.setattr(merl, "tabulate", lambda m: (_ for _ in ()).throw(AssertionError("tabulated first")))
     with pytest.raises(ValueError, match="does not exist"):
         bk.save_merl(bk.model("lambert"), tmp_path / "x" / "y" / "z.binary")
+
+
+def test_a_bad_argument_creates_no_folder(tmp_path, capsys):
+    """Cheap argument checks come before the output check, which may create a folder level."""
+    bad_scene = tmp_path / "bad.json"
+    bad_scene.write_text('{"size": [0, 5]}')
+    cases = [
+        ["fit", "-m", "ward", "--all-measured", "--set", "xx", "-o", "{tmp}/new"],
+        ["render", "--scene", str(bad_scene), "-o", "{tmp}/new/x.png"],
+        ["plot", "no-such-model", "-o", "{tmp}/new/p.png"],
+        ["gallery", "--only", "no-such-figure", "-o", "{tmp}/new"],
+    ]
+    for argv in cases:
+        rc = main([a.replace("{tmp}", str(tmp_path)) for a in argv])
+        err = capsys.readouterr().err
+        assert rc == 2 and "created folder" not in err, err
+        assert not (tmp_path / "new").exists(), argv

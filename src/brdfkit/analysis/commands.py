@@ -188,11 +188,11 @@ def register(app: typer.Typer) -> None:
             raise ValueError(f"plot: --phi-d must lie in [0, 360] degrees, got {phi_d:g}")
         if kind in ("polar", "lobe") and not 0.0 <= theta_i <= 90.0:
             raise ValueError(f"plot: --theta-i must lie in [0, 90] degrees, got {theta_i:g}")
+        models = [model_from_cli(n, items) for n, items in parse_model_groups(spec)]
         from ..fileio import check_output_path
         from .plots import FORMATS
 
         check_output_path(output, what="plot", suffixes=FORMATS, notify=_note)
-        models = [model_from_cli(n, items) for n, items in parse_model_groups(spec)]
         opts: dict[str, Any] = {"log": log}
         if kind == "polar":
             opts.update(theta_i_deg=theta_i, phi_i_deg=phi_i or 0.0, cosine=not no_cos)

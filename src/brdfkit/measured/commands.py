@@ -134,13 +134,6 @@ def register(app: typer.Typer) -> None:
             raise ValueError("missing --model NAME; valid models: " + ", ".join(registry.names()))
         for m in model:
             registry.get(m)
-        from ..fileio import check_output_path  # output folders checked before the fitting starts
-
-        _note = lambda msg: typer.echo(f"brdfkit: {msg}", err=True)  # noqa: E731
-        if all_measured:
-            check_output_path(out, what="--out", is_dir=True, notify=_note)
-        elif report:
-            check_output_path(report, what="--report", is_dir=True, notify=_note)
         if all_measured:
             if source is not None:
                 raise ValueError("give either SOURCE or --all-measured, not both")
@@ -153,11 +146,19 @@ def register(app: typer.Typer) -> None:
         _single(source, model[0], param, metric, starts, samples, seed, as_json, report)
 
 
+def _note(message: str) -> None:
+    typer.echo(f"brdfkit: {message}", err=True)
+
+
 def _single(source, model_name, param, metric, starts, samples, seed, as_json, report) -> None:
     from .fit import fit, resolve_source
 
     fixed = _fixed_for(model_name, param, strict=True)
     measured = resolve_source(source)
+    if report:  # checked (and its last folder level created) before the fitting starts
+        from ..fileio import check_output_path
+
+        check_output_path(report, what="--report", is_dir=True, notify=_note)
     res = fit(model_name, measured, fixed=fixed, metric=metric, starts=starts, samples=samples, seed=seed,
               progress=not as_json)
     out = res.to_json()
@@ -188,6 +189,9 @@ def _batch(models, param, metric, starts, samples, seed, set_name, limit, out, a
     for item in param:
         if item.partition("=")[0].strip() not in used:
             raise ValueError(f"parameter assignment {item!r} matches none of the models {', '.join(models)}")
+    from ..fileio import check_output_path
+
+    check_output_path(out, what="--out", is_dir=True, notify=_note)  # before the fitting starts
     t0 = time.perf_counter()
     results = fit_batch(models, sources, metric=metric, fixed=fixed, progress=not as_json,
                         starts=starts, samples=samples, seed=seed)

@@ -113,9 +113,9 @@ def register(app: typer.Typer) -> None:
             obj["srgb"] = srgb
         if material is not None:
             obj["material"] = material  # an object: scene_from_json takes it as it is
-        check_output_path(output, what="image", suffixes=IMAGE_SUFFIXES, notify=lambda m: typer.echo(f"brdfkit: {m}", err=True))
         # the look: the material's defaults, then the scene file's fields, then the flags (already in obj)
         parsed, look = sc.scene_from_json(obj, base_dir=base)
+        check_output_path(output, what="image", suffixes=IMAGE_SUFFIXES, notify=lambda m: typer.echo(f"brdfkit: {m}", err=True))
         t0 = time.perf_counter()
         frame = sc.render(parsed, look, backend=backend)
         dt = time.perf_counter() - t0
