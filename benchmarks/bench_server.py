@@ -1,15 +1,16 @@
 """Load test of the explorer's HTTP server: loopback only, bounded, stops by itself.
 
-Starts ``brdfkit.web.start_in_thread("127.0.0.1", 0)`` in this process, then
-``--clients`` threads (default 16) each keep one HTTP/1.1 connection alive and
+Starts the server (``brdfkit.web.make_server("127.0.0.1", 0)``) in a child
+process (``--in-process``: in a thread of this one), then ``--clients`` threads (default 16) each keep one HTTP/1.1 connection alive and
 send ``--requests`` requests (default 200) round-robin over a small mix of
 endpoints (``/api/eval`` single and 64-pair, ``/api/models``, the page,
 ``/api/shader/ward``). Prints requests/s and the p50/p90/p99/max latency,
 and the number of errors (any status other than 200, any exception).
 Goal (issue 14): p99 < 50 ms at 16 clients, no error.
 
-Both the clients and the server run in this Python process (one GIL), so the
-figures are a lower bound for the server alone.
+The child process is stopped at the end whatever happens; each client joins
+within 120 s or is counted as an error. With ``--in-process`` the clients and
+the server share one GIL, so the figures are a lower bound for the server.
 
     python benchmarks/bench_server.py [--clients 16] [--requests 200]
 """
@@ -19,7 +20,9 @@ from __future__ import annotations
 import argparse
 import http.client
 import json
+import os
 import statistics
+import subprocess
 import sys
 import threading
 import time
@@ -39,9 +42,49 @@ def _paths() -> list[str]:
     ]
 
 
-def run(clients: int, requests: int) -> dict:
-    srv, thread = start_in_thread("127.0.0.1", 0)
-    host, port = srv.server_address[:2]
+_CHILD = (
+    "import sys; from brdfkit.web import make_server; s = make_server('127.0.0.1', 0); "
+    "print(s.server_address[1], flush=True); s.serve_forever()"
+)
+
+
+def _start(in_process: bool):
+    """(host, port, stop) of a running server."""
+    if in_process:
+        srv, thread = start_in_thread("127.0.0.1", 0)
+
+        def stop() -> None:
+            srv.shutdown()
+            srv.server_close()
+            thread.join(5)
+
+        return "127.0.0.1", srv.server_address[1], stop
+    child = subprocess.Popen([sys.executable, "-c", _CHILD], stdout=subprocess.PIPE, env=dict(os.environ))
+    line = child.stdout.readline()
+    if not line.strip().isdigit():
+        child.kill()
+        raise RuntimeError("the server process did not start")
+
+    def stop() -> None:
+        child.terminate()
+        try:
+            child.wait(5)
+        except subprocess.TimeoutExpired:
+            child.kill()
+            child.wait(5)
+
+    return "127.0.0.1", int(line), stop
+
+
+def run(clients: int, requests: int, in_process: bool = False) -> dict:
+    host, port, stop = _start(in_process)
+    try:
+        return _load(host, port, clients, requests)
+    finally:
+        stop()
+
+
+def _load(host: str, port: int, clients: int, requests: int) -> dict:
     paths = _paths()
     lat: list[float] = []
     errors: list[str] = []
@@ -87,9 +130,6 @@ def run(clients: int, requests: int) -> dict:
         t.join(120)  # bounded: a hung client is reported, not waited for
     wall = time.perf_counter() - t0
     hung = sum(t.is_alive() for t in threads)
-    srv.shutdown()
-    srv.server_close()
-    thread.join(5)
     lat.sort()
     q = lambda f: lat[min(len(lat) - 1, int(f * len(lat)))] * 1e3  # noqa: E731
     return {
@@ -111,10 +151,15 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--clients", type=int, default=16)
     ap.add_argument("--requests", type=int, default=200, help="requests per client")
+    ap.add_argument("--in-process", action="store_true", help="run the server in a thread of this process")
     a = ap.parse_args(argv)
     if not 1 <= a.clients <= 256 or not 1 <= a.requests <= 100_000:
         ap.error("--clients must be in [1, 256] and --requests in [1, 100000]")
-    r = run(a.clients, a.requests)
+    r = run(a.clients, a.requests, a.in_process)
+    print(
+        f"server {'in this process' if a.in_process else 'in a child process'}, load average "
+        f"{os.getloadavg()[0]:.1f} on {os.cpu_count()} CPUs"
+    )
     print(
         f"{r['clients']} clients, {r['requests']} requests in {r['wall_s']:.2f} s: {r['rps']:.0f} requests/s; "
         f"latency p50 {r['p50_ms']:.2f} ms, p90 {r['p90_ms']:.2f} ms, p99 {r['p99_ms']:.2f} ms, "

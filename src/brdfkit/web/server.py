@@ -25,7 +25,7 @@ and ``{"error": "<one line>"}``, an unknown path 404, the same shape):
     3 numbers or one number, choices by name, booleans as true/false);
     ``wi``/``wo`` are ``x,y,z`` (normalised here; the zero vector is rejected)
     or JSON arrays ``[x,y,z]`` / ``[[x,y,z], ...]`` (broadcast against each
-    other; the request target is limited to 16 KiB, about 400 pairs per
+    other; the request line is limited to 64 KiB, about 1 500 pairs per
     request). Answers ``{"model", "params" (the
     effective parameters), "wi", "wo", "value"}`` where ``value`` is ``[r,g,b]``
     or a list of them.
@@ -75,7 +75,7 @@ import numpy as np
 STATIC_DIR = Path(__file__).resolve().with_name("static")
 MAX_PAIRS = 100_000
 MAX_BODY = 1 << 20  # bytes of a request body
-MAX_TARGET = 16384  # characters of the request target (path and query)
+MAX_TARGET = 65536  # characters of the request target (path and query), http.server's own line limit
 MAX_JSON_DEPTH = 8  # nesting of the JSON in a query
 
 
