@@ -115,20 +115,27 @@ def test_keep_alive_latency_is_a_few_milliseconds(srv):
 
 
 def test_slow_and_silent_clients_do_not_block_others(srv, monkeypatch):
-    monkeypatch.setattr(web_server.Handler, "timeout", 1.0)
+    st, _, _ = _raw(srv, f"GET /api/models HTTP/1.1\r\nHost: {_host(srv)}\r\n\r\n".encode())  # warm the cache
+    assert st == 200
+    monkeypatch.setattr(web_server.Handler, "timeout", 3.0)
+    t_open = time.perf_counter()
     silent = [_connect(srv) for _ in range(8)]  # connect, send nothing
     dribble = _connect(srv)
     dribble.sendall(b"GET /api/models HT")  # half a request line, then nothing
     try:
-        t0 = time.perf_counter()
         st, _, body = _raw(srv, f"GET /api/models HTTP/1.1\r\nHost: {_host(srv)}\r\n\r\n".encode())
+        answered = time.perf_counter() - t_open
         assert st == 200 and json.loads(body)["models"]
-        assert time.perf_counter() - t0 < 0.9  # not waiting for the silent ones' timeout
+        assert answered < 2.5  # served while the silent ones still hold their workers (timeout 3 s)
         # and the silent connections are closed by the server once their timeout passes
-        silent[0].settimeout(5)
-        t1 = time.perf_counter()
-        assert silent[0].recv(100) == b""
-        assert 0.5 < time.perf_counter() - t1 + (t1 - t0) < 4.0
+        silent[0].settimeout(20)
+        assert silent[0].recv(100) == b""  # closed by the server, not by us
+        assert time.perf_counter() - t_open > 2.5
+        dribble.settimeout(20)
+        tail = b""
+        while chunk := dribble.recv(4096):  # the half request line ends in a close too
+            tail += chunk
+        assert b"HTTP/1.1 200" not in tail
     finally:
         for c in silent + [dribble]:
             c.close()
@@ -245,3 +252,33 @@ def test_many_concurrent_clients_all_answered(srv):
     for t in threads:
         t.join(60)
     assert errors == []
+
+
+def test_a_full_pool_answers_503_instead_of_piling_up(monkeypatch):
+    monkeypatch.setattr(web_server.Server, "workers", 2)
+    monkeypatch.setattr(web_server.Server, "waiting", 1)
+    monkeypatch.setattr(web_server.Handler, "timeout", 3.0)
+    s, thread = start_in_thread("127.0.0.1", 0)
+    held = []
+    try:
+        assert len(s._threads) == 2
+
+        def settle(busy: int, queued: int) -> None:
+            deadline = time.monotonic() + 10
+            while (s.busy, s._queue.qsize()) != (busy, queued) and time.monotonic() < deadline:
+                time.sleep(0.01)
+
+        for busy, queued in ((1, 0), (2, 0), (2, 1)):  # two silent clients occupy the workers, one waits
+            held.append(_connect(s))
+            settle(busy, queued)
+        assert s._queue.full()
+        with _connect(s) as c:  # the line is full: refused at once, not left hanging
+            c.sendall(f"GET /api/models HTTP/1.1\r\nHost: {_host(s)}\r\n\r\n".encode())
+            st, h, body = _read_response(c.makefile("rb"))
+        assert st == 503 and h.get("connection") == "close" and json.loads(body)["error"]
+    finally:
+        for c in held:
+            c.close()
+        s.shutdown()
+        s.server_close()
+        thread.join(5)

@@ -499,6 +499,8 @@ class Server(HTTPServer):
         self._extra_hosts = {h.strip().lower() for h in allowed_hosts if h and h.strip()}
         self._queue: queue.Queue = queue.Queue(maxsize=self.waiting)
         self._threads: list[threading.Thread] = []
+        self._busy_lock = threading.Lock()
+        self.busy = 0  # workers serving a connection now
         super().__init__(address, handler)
         for i in range(self.workers):
             t = threading.Thread(target=self._work, name=f"brdfkit-web-{i}", daemon=True)
@@ -553,12 +555,16 @@ class Server(HTTPServer):
             if item is None:
                 return
             request, client_address = item
+            with self._busy_lock:
+                self.busy += 1
             try:
                 self.finish_request(request, client_address)
             except Exception:  # pragma: no cover - a handler bug must not kill the worker
                 pass
             finally:
                 self.shutdown_request(request)
+                with self._busy_lock:
+                    self.busy -= 1
 
     def server_close(self) -> None:
         super().server_close()
