@@ -134,3 +134,8 @@ def test_readme_scene_example_points_at_a_shipped_file():
     readme = (root / "README.md").read_text()
     assert "--scene docs/scene.json" in readme
     assert (root / "docs" / "scene.json").is_file()
+
+
+def test_integer_options_too_large_for_c_are_exit_2(capsys):
+    rc, _, err = _run(capsys, ["check", "--all", "--jobs", "1" + "0" * 23])
+    assert rc == 2 and "--jobs" in err, err

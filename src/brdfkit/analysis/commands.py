@@ -95,8 +95,8 @@ def register(app: typer.Typer) -> None:
 
         if level is not None and level not in LEVELS:
             raise ValueError(f"check: --level must be one of {', '.join(LEVELS)}, got {level!r}")
-        if jobs < 1:
-            raise ValueError(f"check: --jobs must be at least 1, got {jobs}")
+        if not 1 <= jobs <= 256:
+            raise ValueError(f"check: --jobs must lie in [1, 256], got {jobs}")
         if all_models:
             if model is not None or param:
                 raise ValueError("check: give either MODEL [-p ...] or --all, not both")
