@@ -86,6 +86,10 @@ def test_oversized_and_chunked_bodies_are_refused_with_close(srv):
     n = web_server.MAX_BODY + 1
     st, h, body = _raw(srv, f"POST /x HTTP/1.1\r\nHost: {_host(srv)}\r\nContent-Length: {n}\r\n\r\n".encode())
     assert st == 413 and h.get("connection") == "close", (st, h)
+    st, h, body = _raw(srv, f"POST /api/eval HTTP/1.1\r\nHost: {_host(srv)}\r\nContent-Length: 3\r\n\r\nabc".encode())
+    assert st == 405  # a GET endpoint: wrong method
+    st, h, body = _raw(srv, f"POST /api/nothing HTTP/1.1\r\nHost: {_host(srv)}\r\nContent-Length: 3\r\n\r\nabc".encode())
+    assert st == 404  # no such endpoint at all
     st, h, _ = _raw(srv, f"POST /x HTTP/1.1\r\nHost: {_host(srv)}\r\nTransfer-Encoding: chunked\r\n\r\n0\r\n\r\n".encode())
     assert st == 411 and h.get("connection") == "close"
     for bad in ("-5", "abc", "1, 2"):
@@ -228,6 +232,15 @@ def test_extra_routes_get_the_body_and_their_errors_are_400(srv, monkeypatch):
     assert seen == {"query": {"x": ["1"]}, "body": payload}
     st, _, body = _raw(srv, f"POST /api/test-echo HTTP/1.1\r\nHost: {_host(srv)}\r\nContent-Length: 3\r\n\r\nbad".encode())
     assert st == 400 and json.loads(body) == {"error": "bad input for echo"}
+    # an upload route may take more than MAX_BODY when web.api says so (a MERL file is 33 MB)
+    monkeypatch.setattr(api, "MAX_UPLOAD", 3 * web_server.MAX_BODY, raising=False)
+    big = bytes(range(256)) * (2 * web_server.MAX_BODY // 256)
+    st, _, body = _raw(
+        srv, f"POST /api/test-echo HTTP/1.1\r\nHost: {_host(srv)}\r\nContent-Length: {len(big)}\r\n\r\n".encode() + big
+    )
+    assert st == 200 and body == big[::-1]
+    st, h, _ = _raw(srv, f"POST /api/test-echo HTTP/1.1\r\nHost: {_host(srv)}\r\nContent-Length: {4 * web_server.MAX_BODY}\r\n\r\n".encode())
+    assert st == 413 and h.get("connection") == "close"
 
 
 def test_many_concurrent_clients_all_answered(srv):

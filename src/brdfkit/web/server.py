@@ -36,7 +36,7 @@ is consulted, so other modules can add endpoints without touching this file.
 HTTP
 ----
 * Every request body is read (``Content-Length``, at most :data:`MAX_BODY`
-  bytes) before the answer, so a body can never be taken for a second request
+  bytes, or ``api.MAX_UPLOAD`` for the upload routes of ``api.ROUTES``) before the answer, so a body can never be taken for a second request
   on a kept-alive connection; a larger, malformed or chunked body is refused
   (413 / 400 / 411) with ``Connection: close``.
 * Nagle's algorithm is off (``TCP_NODELAY``): a kept-alive answer is not held
@@ -307,7 +307,19 @@ class Handler(BaseHTTPRequestHandler):
         self._json(status, {"error": message}, close=close)
 
     # -- request checks -------------------------------------------------------
-    def _read_body(self) -> bytes:
+    def _body_limit(self, method: str) -> int:
+        """:data:`MAX_BODY`, or the upload limit ``api.MAX_UPLOAD`` for a route of :data:`api.ROUTES`."""
+        from . import api
+
+        try:
+            path = unquote(urlsplit(self.path).path)
+        except ValueError:
+            return MAX_BODY
+        if (method, path) in api.ROUTES:
+            return max(MAX_BODY, int(getattr(api, "MAX_UPLOAD", MAX_BODY)))
+        return MAX_BODY
+
+    def _read_body(self, limit: int = MAX_BODY) -> bytes:
         """The whole request body (so that it cannot be read as the next request), or :class:`_Refuse`."""
         if self.headers.get("Transfer-Encoding"):
             raise _Refuse(HTTPStatus.LENGTH_REQUIRED, "chunked request bodies are not accepted; send Content-Length")
@@ -317,8 +329,8 @@ class Handler(BaseHTTPRequestHandler):
         if len(set(v.strip() for v in lengths)) != 1 or not lengths[0].strip().isdigit():
             raise _Refuse(HTTPStatus.BAD_REQUEST, "bad Content-Length header")
         n = int(lengths[0].strip())
-        if n > MAX_BODY:
-            raise _Refuse(HTTPStatus.REQUEST_ENTITY_TOO_LARGE, f"request body of {n} bytes; at most {MAX_BODY}")
+        if n > limit:
+            raise _Refuse(HTTPStatus.REQUEST_ENTITY_TOO_LARGE, f"request body of {n} bytes; at most {limit}")
         chunks, left = [], n
         while left > 0:
             chunk = self.rfile.read(min(left, 65536))
@@ -360,7 +372,7 @@ class Handler(BaseHTTPRequestHandler):
         head_only = method == "HEAD"
         try:
             try:
-                body = self._read_body()
+                body = self._read_body(self._body_limit(method))
             except _Refuse as e:
                 self._error(e.status, str(e), close=True)
                 return
@@ -387,7 +399,7 @@ class Handler(BaseHTTPRequestHandler):
                 return
             if self._extra(method, path, url.query, body, head_only):
                 return
-            if method not in ("GET", "HEAD"):
+            if method not in ("GET", "HEAD") and self._exists(path):
                 self._error(HTTPStatus.METHOD_NOT_ALLOWED, f"{method} is not supported on {_clip(path)}")
             elif path.startswith("/api/"):
                 self._error(
@@ -403,6 +415,25 @@ class Handler(BaseHTTPRequestHandler):
             self.close_connection = True
         except Exception as e:  # pragma: no cover - a bug: status 500, the exception's type only (no paths)
             self._error(HTTPStatus.INTERNAL_SERVER_ERROR, f"internal error ({type(e).__name__})")
+
+    def _exists(self, path: str) -> bool:
+        """Whether ``path`` is served for some method (then a wrong method is 405, else 404)."""
+        from . import api
+
+        if path in ("/api/models", "/api/eval") or path.startswith("/api/shader/"):
+            return True
+        if any(p == path for (_m, p) in api.ROUTES):
+            return True
+        if path.startswith("/api/"):
+            return False
+        rel = "index.html" if path in ("", "/") else path.lstrip("/").removeprefix("static/")
+        if "\\" in rel or any(part in ("..", "") for part in rel.split("/")) or len(rel) > 255:
+            return False
+        try:
+            target = (STATIC_DIR / rel).resolve()
+            return STATIC_DIR in target.parents and target.is_file()
+        except (OSError, ValueError):
+            return False
 
     def _builtin(self, path: str, query: str, head_only: bool) -> bool:
         """This module's own GET routes; False when ``path`` is none of them."""
