@@ -65,16 +65,14 @@ def write_batch(results, models: list[str], sources: list[str], out_dir: str, me
     os.makedirs(out_dir, exist_ok=True)
     table = {(r.source, r.model.name): r for r in results}
     csv_path = os.path.join(out_dir, "fit_errors.csv")
-    from ..fileio import atomic_open, atomic_path
-
-    with atomic_open(csv_path, "w") as fh:
+    with open(csv_path, "w") as fh:
         fh.write("material," + ",".join(models) + "\n")
         for s in sources:
             fh.write(s + "," + ",".join(f"{table[(s, m)].error:.6g}" for m in models) + "\n")
     md_path = os.path.join(out_dir, "fit_errors.md")
     errs = np.array([[table[(s, m)].error for m in models] for s in sources])
     best = errs.argmin(axis=1)
-    with atomic_open(md_path, "w") as fh:
+    with open(md_path, "w") as fh:
         fh.write(f"Fitting error per material and model; metric: {metric}. Best per row in bold.\n\n")
         fh.write("| material | " + " | ".join(models) + " |\n")
         fh.write("|---|" + "---:|" * len(models) + "\n")
@@ -96,11 +94,10 @@ def write_batch(results, models: list[str], sources: list[str], out_dir: str, me
     ax.grid(True, which="both", alpha=0.3)
     ax.legend()
     fig.tight_layout()
-    with atomic_path(png_path) as tmp:
-        fig.savefig(tmp, format="png")
+    fig.savefig(png_path)
     plt.close(fig)
     json_path = os.path.join(out_dir, "fit_params.json")
-    with atomic_open(json_path, "w") as fh:
+    with open(json_path, "w") as fh:
         json.dump([r.to_json() for r in results], fh, indent=1)
     return {"csv": csv_path, "markdown": md_path, "plot": png_path, "params": json_path}
 
@@ -146,19 +143,11 @@ def register(app: typer.Typer) -> None:
         _single(source, model[0], param, metric, starts, samples, seed, as_json, report)
 
 
-def _note(message: str) -> None:
-    typer.echo(f"brdfkit: {message}", err=True)
-
-
 def _single(source, model_name, param, metric, starts, samples, seed, as_json, report) -> None:
     from .fit import fit, resolve_source
 
     fixed = _fixed_for(model_name, param, strict=True)
     measured = resolve_source(source)
-    if report:  # checked (and its last folder level created) before the fitting starts
-        from ..fileio import check_output_path
-
-        check_output_path(report, what="--report", is_dir=True, notify=_note)
     res = fit(model_name, measured, fixed=fixed, metric=metric, starts=starts, samples=samples, seed=seed,
               progress=not as_json)
     out = res.to_json()
@@ -189,9 +178,6 @@ def _batch(models, param, metric, starts, samples, seed, set_name, limit, out, a
     for item in param:
         if item.partition("=")[0].strip() not in used:
             raise ValueError(f"parameter assignment {item!r} matches none of the models {', '.join(models)}")
-    from ..fileio import check_output_path
-
-    check_output_path(out, what="--out", is_dir=True, notify=_note)  # before the fitting starts
     t0 = time.perf_counter()
     results = fit_batch(models, sources, metric=metric, fixed=fixed, progress=not as_json,
                         starts=starts, samples=samples, seed=seed)

@@ -25,7 +25,6 @@ from typing import Any
 import numpy as np
 
 from ..geometry import spherical_to_vector, vector_to_spherical
-from ..fileio import atomic_open, atomic_path
 
 SLICE_THETA_I_DEG = (20.0, 45.0, 70.0)
 #: (direction in camera space (+z toward the viewer), irradiance): a key light and a weaker fill
@@ -83,8 +82,7 @@ def write_report(result, measured, out_dir: str) -> dict[str, Any]:
     fig.suptitle(f"{result.source}: measured (solid) vs {fitted.name} fit (dashed), error {result.error:.4g} ({result.metric})")
     fig.tight_layout()
     slices = os.path.join(out_dir, "slices.png")
-    with atomic_path(slices) as tmp:
-        fig.savefig(tmp, format="png")
+    fig.savefig(slices)
     plt.close(fig)
 
     # -- spheres ---------------------------------------------------------------------
@@ -100,16 +98,15 @@ def write_report(result, measured, out_dir: str) -> dict[str, Any]:
         ax.axis("off")
     fig.tight_layout()
     spheres = os.path.join(out_dir, "spheres.png")
-    with atomic_path(spheres) as tmp:
-        fig.savefig(tmp, format="png", facecolor="white")
+    fig.savefig(spheres, facecolor="white")
     plt.close(fig)
 
     js = os.path.join(out_dir, "fit.json")
-    with atomic_open(js, "w") as fh:
+    with open(js, "w") as fh:
         json.dump(result.to_json(), fh, indent=2)
     index = os.path.join(out_dir, "index.md")
     params = result.to_json()["params"]
-    with atomic_open(index, "w") as fh:
+    with open(index, "w") as fh:
         fh.write(f"# Fit of `{fitted.name}` to `{result.source}`\n\n")
         fh.write(f"Error {result.error:.6g} (metric `{result.metric}`), {result.samples} samples, "
                  f"{result.starts} starts, {result.seconds:.1f} s.\n\n")

@@ -345,9 +345,6 @@ def run_gallery(out_dir: str | Path, names: Sequence[str] | None = None, size: i
             bar.update(task, description=fig.name)
             img = render_figure(fig, size, lambda: bar.advance(task), mesh_cache, panels)
             path = out / f"{fig.name}.png"
-            from ..fileio import atomic_path
-
-            with atomic_path(path) as tmp:  # brdfkit.fileio: the previous file survives a killed write
-                img.save(tmp, format="PNG", optimize=True)
+            img.save(path, optimize=True)
             written.append(path)
     return written

@@ -279,7 +279,7 @@ def scene_from_json(obj: Mapping[str, Any], base_dir: str | os.PathLike | None =
     extra = set(obj) - set(SCENE_FIELDS) - set(OPEN_FIELDS)
     if extra:
         raise ValueError(
-            f"scene: unknown field(s) {', '.join(sorted(map(str, extra)))}; valid fields: {', '.join(SCENE_FIELDS + OPEN_FIELDS)}"
+            f"scene: unknown field(s) {', '.join(sorted(map(str, extra)))}; valid fields: {', '.join(dict.fromkeys(SCENE_FIELDS + OPEN_FIELDS))}"
         )
     _check_fields(obj)
     mesh_spec = obj.get("mesh", "teapot")
