@@ -168,3 +168,49 @@ def test_shipped_example_scene_renders(tmp_path, capsys):
 
     img = np.asarray(Image.open(out))
     assert img.shape[:2] == (48, 48) and img[..., :3].max() > 50  # something lit, not a black frame
+
+
+# --------------------------------------------------------------------------- fuzz
+from hypothesis import HealthCheck, given, settings, strategies as st  # noqa: E402
+
+_json = st.recursive(
+    st.none() | st.booleans() | st.integers(-(10**30), 10**30) | st.floats(allow_nan=True, allow_infinity=True)
+    | st.sampled_from(["teapot", "sphere", "gold", "phong", "lambert", "aces", "x", ""]),
+    lambda kids: st.lists(kids, max_size=5) | st.dictionaries(st.text(max_size=8), kids, max_size=4),
+    max_leaves=12,
+)
+_small_mesh = st.fixed_dictionaries(
+    {"builtin": st.sampled_from(["sphere", "torus", "plane", "teapot", "cube"])},
+    optional={"segments": _json | st.integers(-5, 40), "rings": _json | st.integers(-5, 20),
+              "sides": _json | st.integers(-5, 20), "divisions": _json | st.integers(-5, 20),
+              "subdivisions": _json | st.integers(-5, 6), "radius": _json},
+)
+_scene = st.fixed_dictionaries(
+    {},
+    optional={
+        "mesh": _small_mesh | _json,
+        "camera": _json | st.fixed_dictionaries({}, optional={"eye": _json, "fov_deg": _json, "target": _json}),
+        "size": _json | st.lists(st.integers(-3, 40), min_size=2, max_size=2),
+        "lights": _json | st.lists(st.dictionaries(st.sampled_from(["position", "diffuse", "spot_cutoff", "x"]), _json), max_size=3),
+        "light_model": _json,
+        "material": _json | st.fixed_dictionaries({"model": st.sampled_from(["ward", "lambert", "nope"])}, optional={"params": _json}),
+        "shading": _json, "background": _json, "antialias": _json,
+        "tonemap": _json, "exposure": _json, "srgb": _json,
+    },
+)
+
+
+@settings(max_examples=400, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(_scene)
+def test_fuzzed_scenes_build_or_fail_with_one_line_value_error(obj):
+    try:
+        scene, look = sc.scene_from_json(obj)
+    except (ValueError, OSError) as e:
+        msg = str(e)
+        assert msg and "\n" not in msg.strip(), msg
+        # the message names what is wrong: a scene field, or the look's tonemap/exposure/srgb
+        assert msg.startswith(("scene", "a scene", "tonemap", "exposure", "srgb")), msg
+        return
+    assert 1 <= scene.size[0] <= sc.MAX_SIZE and 1 <= scene.size[1] <= sc.MAX_SIZE
+    assert scene.mesh.n_triangles > 0 and np.all(np.isfinite(scene.mesh.positions))
+    assert np.all(np.isfinite(scene.projection)) and np.all(np.isfinite(scene.modelview))

@@ -295,3 +295,30 @@ def test_a_full_pool_answers_503_instead_of_piling_up(monkeypatch):
         s.shutdown()
         s.server_close()
         thread.join(5)
+
+
+from hypothesis import HealthCheck, given, settings, strategies as st  # noqa: E402
+
+_TARGET_PARTS = st.sampled_from(
+    ["/", "/api/", "/api/eval", "/api/models", "/api/shader/", "/static/", "index.html", "app.js", "..", "%00", "%2e%2e",
+     "%2f", "%ff", "?", "&", "=", "model=ward", "params=", "%7B%22kd%22:", "[[", "]]", "1e400", "wi=0,0,1", "wo=",
+     "\\", "//", "%0a", "#", ";", "~", "\x7f", "\xe9"]
+)
+
+
+@settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(st.lists(_TARGET_PARTS | st.text(max_size=6), max_size=12), st.sampled_from(["GET", "HEAD", "POST", "PUT", "OPTIONS"]))
+def test_fuzzed_targets_never_500_nor_disclose_paths(srv, parts, method):
+    target = "/" + "".join(parts)
+    data = f"{method} {target} HTTP/1.1\r\nHost: {_host(srv)}\r\nContent-Length: 0\r\n\r\n".encode("utf-8", "replace")
+    with _connect(srv) as c:
+        c.sendall(data)
+        f = c.makefile("rb")
+        line = f.readline()
+        if not line:  # the server may close on a request line it cannot parse
+            return
+        status = int(line.split()[1])
+        rest = f.read1(65536) if hasattr(f, "read1") else b""
+    assert status in (200, 400, 403, 404, 405, 414), (target, status)
+    text = rest.decode("utf-8", "replace")
+    assert str(web_server.STATIC_DIR.parent) not in text and "Traceback" not in text, text[:300]

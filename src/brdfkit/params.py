@@ -62,7 +62,7 @@ def to_float(value: Any, what: str, *, finite: bool = True) -> float:
                 raise ValueError(f"{what} must be finite, got {value!r}")
             raise ValueError(f"{what} = {value!r} overflows a float (largest {sys.float_info.max:.4g})")
         return f
-    if not isinstance(value, (int, float, np.number)) and np.ndim(value) != 0:
+    if isinstance(value, (list, tuple, dict, set, frozenset)) or (isinstance(value, np.ndarray) and value.ndim != 0):
         raise ValueError(f"{what} must be a single number, got {_short(value)}")
     try:
         f = float(value)

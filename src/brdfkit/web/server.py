@@ -280,10 +280,20 @@ class Handler(BaseHTTPRequestHandler):
     def send_error(self, code: int, message: str | None = None, explain: str | None = None) -> None:
         """The stdlib's own errors (bad request line, 414, 431...) as our JSON shape, always closing."""
         self.close_connection = True
+        if getattr(self, "request_version", "HTTP/0.9") == "HTTP/0.9":  # answer with a status line anyway
+            self.request_version = "HTTP/1.0"
         try:
             self._json(code, {"error": message or HTTPStatus(code).phrase}, close=True)
         except OSError:  # pragma: no cover - the client went away
             pass
+
+    def parse_request(self) -> bool:
+        """The stdlib's parsing, minus HTTP/0.9 (``GET /`` without a version: no status line, no headers)."""
+        ok = super().parse_request()
+        if ok and self.request_version == "HTTP/0.9":
+            self.send_error(HTTPStatus.BAD_REQUEST, "HTTP/0.9 requests are not supported; send HTTP/1.0 or 1.1")
+            return False
+        return ok
 
     # -- responses ----------------------------------------------------------
     def _send(self, status: int, body: bytes, ctype: str, head_only: bool = False, close: bool = False) -> None:
