@@ -214,3 +214,29 @@ def test_fuzzed_scenes_build_or_fail_with_one_line_value_error(obj):
     assert 1 <= scene.size[0] <= sc.MAX_SIZE and 1 <= scene.size[1] <= sc.MAX_SIZE
     assert scene.mesh.n_triangles > 0 and np.all(np.isfinite(scene.mesh.positions))
     assert np.all(np.isfinite(scene.projection)) and np.all(np.isfinite(scene.modelview))
+
+
+_num = st.one_of(st.floats(allow_nan=True, allow_infinity=True, width=64), st.integers(-3, 3)).map(lambda x: repr(x) if not isinstance(x, float) else f"{x!r}")
+_obj_line = st.one_of(
+    st.tuples(st.just("v"), _num, _num, _num).map(" ".join),
+    st.tuples(st.just("vn"), _num, _num, _num).map(" ".join),
+    st.tuples(st.just("f"), *[st.integers(-4, 6).map(str)] * 3).map(" ".join),
+    st.tuples(st.just("f"), *[st.integers(-4, 6).map(str)] * 4).map(" ".join),
+    st.sampled_from(["# comment \udcff", "o thing", "usemtl \xe9", "s off", "garbage line", "", "f", "v 1"]),
+)
+
+
+@settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
+@given(st.lists(_obj_line, max_size=14))
+def test_fuzzed_obj_files_load_validly_or_fail_with_value_error(tmp_path, lines):
+    p = tmp_path / "fuzz.obj"
+    p.write_bytes("\n".join(lines).encode("utf-8", "surrogateescape"))
+    try:
+        m = meshes.load_mesh(p)
+    except ValueError as e:
+        assert "\n" not in str(e).strip()
+        return
+    assert m.n_triangles > 0
+    assert np.all(np.isfinite(m.positions)) and np.all(np.isfinite(m.normals)) and np.all(np.isfinite(m.tangents))
+    assert meshes.triangle_areas(m.positions, m.faces).min() > 0
+    assert m.faces.min() >= 0 and m.faces.max() < m.n_vertices

@@ -325,7 +325,7 @@ def load_mesh(path: str | os.PathLike, normalize: bool = True) -> Mesh:
         raise ValueError(f"mesh {name}: faces index vertices that do not exist")
     if normalize:
         P = _fit_unit_sphere(P)
-    area = triangle_areas(P, F)
+    area = triangle_areas(P.astype(np.float32), F)  # as the renderer will see them (float32)
     keep = area > 0
     if not keep.any():
         raise ValueError(f"mesh {name}: every triangle is degenerate (zero area); nothing to render")
