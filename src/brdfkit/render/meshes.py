@@ -319,6 +319,8 @@ def load_mesh(path: str | os.PathLike, normalize: bool = True) -> Mesh:
     P = np.asarray(tm.vertices, dtype=np.float64)
     F = np.asarray(tm.faces, dtype=np.int64)
     name = os.path.basename(path)
+    if P.ndim != 2 or P.shape[1] != 3 or len(P) == 0 or F.ndim != 2 or F.shape[1] != 3:
+        raise ValueError(f"mesh {name}: malformed vertices or faces (shapes {P.shape} and {F.shape}); each vertex needs x y z")
     if not np.all(np.isfinite(P)) or np.abs(P).max() > MAX_COORD:
         raise ValueError(f"mesh {name}: vertex coordinates must be finite and at most {MAX_COORD:g} in magnitude")
     if F.min() < 0 or F.max() >= len(P):
