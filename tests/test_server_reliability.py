@@ -322,3 +322,23 @@ def test_fuzzed_targets_never_500_nor_disclose_paths(srv, parts, method):
     assert status in (200, 400, 403, 404, 405, 414), (target, status)
     text = rest.decode("utf-8", "replace")
     assert str(web_server.STATIC_DIR.parent) not in text and "Traceback" not in text, text[:300]
+
+
+def test_head_errors_have_no_body_so_keep_alive_stays_in_step(srv):
+    req = (
+        f"HEAD /api/nothing HTTP/1.1\r\nHost: {_host(srv)}\r\n\r\n"
+        f"HEAD /api/eval?model=nope HTTP/1.1\r\nHost: {_host(srv)}\r\n\r\n"
+        f"GET /api/eval?model=lambert&wi=0,0,1&wo=0,0,1 HTTP/1.1\r\nHost: {_host(srv)}\r\n\r\n"
+    ).encode()
+    with _connect(srv) as c:
+        c.sendall(req)
+        f = c.makefile("rb")
+        statuses = []
+        for _ in range(2):  # HEAD answers: headers only, whatever Content-Length says
+            line = f.readline()
+            statuses.append(int(line.split()[1]))
+            while f.readline() not in (b"\r\n", b""):
+                pass
+        st, _, body = _read_response(f)
+    assert statuses == [404, 400]
+    assert st == 200 and json.loads(body)["value"]

@@ -283,7 +283,8 @@ class Handler(BaseHTTPRequestHandler):
         if getattr(self, "request_version", "HTTP/0.9") == "HTTP/0.9":  # answer with a status line anyway
             self.request_version = "HTTP/1.0"
         try:
-            self._json(code, {"error": message or HTTPStatus(code).phrase}, close=True)
+            self._json(code, {"error": message or HTTPStatus(code).phrase},
+                       head_only=getattr(self, "command", None) == "HEAD", close=True)
         except OSError:  # pragma: no cover - the client went away
             pass
 
@@ -314,7 +315,8 @@ class Handler(BaseHTTPRequestHandler):
         self._send(status, body, "application/json; charset=utf-8", head_only, close)
 
     def _error(self, status: int, message: str, close: bool = False) -> None:
-        self._json(status, {"error": message}, close=close)
+        # an answer to HEAD never has a body, errors included (else the next kept-alive answer is misread)
+        self._json(status, {"error": message}, head_only=getattr(self, "command", None) == "HEAD", close=close)
 
     # -- request checks -------------------------------------------------------
     def _body_limit(self, method: str) -> int:
