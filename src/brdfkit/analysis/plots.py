@@ -474,6 +474,8 @@ def save_figure(fig, path: str | Path, dpi: int = 150) -> Path:
         raise ValueError(f"plot: output must end in {', '.join(FORMATS)}, got {p.name!r}")
     from ..fileio import atomic_path
 
+    if not p.parent.is_dir():
+        raise OSError(f"plot: output folder does not exist: {str(p.parent)!r}")
     FigureCanvasAgg(fig)
     with atomic_path(p) as tmp:  # a killed write leaves the previous file whole
         fig.savefig(tmp, dpi=dpi, format=ext[1:])
