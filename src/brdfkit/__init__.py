@@ -69,3 +69,14 @@ def fit(name: str, measured, fixed=None, metric: str = "ngan", **kw):
 
 
 __all__ += ["load_merl", "save_merl", "material", "materials", "fit"]
+
+
+# -- interchange (brdfkit.interchange; imported on first use) -----------------------
+def load_brdf(path, **params):
+    """A Disney BRDF Explorer ``.brdf`` file as a model (see :mod:`brdfkit.interchange.brdf_explorer`)."""
+    from .interchange.brdf_explorer import load_brdf as _f
+
+    return _f(path, **params)
+
+
+__all__ += ["load_brdf"]
