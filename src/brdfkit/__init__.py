@@ -79,4 +79,13 @@ def load_brdf(path, **params):
     return _f(path, **params)
 
 
-__all__ += ["load_brdf"]
+def export(model, fmt: str, path, **kw):
+    """Write ``model`` as a Mitsuba 3 (``"mitsuba"``), MaterialX (``"materialx"``) or glTF (``"gltf"``)
+    material; returns an ExportResult whose ``error`` is the approximation error (None where exact).
+    See :mod:`brdfkit.interchange.export`."""
+    from .interchange.export import export as _f
+
+    return _f(model, fmt, path, **kw)
+
+
+__all__ += ["load_brdf", "export"]
