@@ -333,3 +333,43 @@ def test_cli_export_json_and_errors(tmp_path):
     r = _cli("export", str(bad), "--to", "gltf", "-o", str(tmp_path / "x.glb"))
     assert r.returncode == 2 and "expected the JSON of 'brdfkit fit" in r.stderr
     assert not (tmp_path / "x.glb").exists()
+
+
+@pytest.mark.parametrize(
+    "cls,params",
+    [
+        (GltfPBR, {}),
+        (GltfPBR, {"metallic": 1.0, "roughness": 0.0, "base_color": 1.0}),
+        (GltfPBR, {"metallic": 0.3, "roughness": 0.05, "ior": 5.0, "specular": 0.5, "specular_color": [1, 0, 0.5]}),
+        (OpenPBRSurface, {}),
+        (OpenPBRSurface, {"base_metalness": 1.0, "specular_roughness": 0.0, "specular_color": 0.0}),
+        (OpenPBRSurface, {"base_metalness": 0.5, "specular_roughness_anisotropy": 1.0, "specular_ior": 5.0}),
+    ],
+)
+def test_target_formulas_keep_the_contract(cls, params):
+    """The targets' formulas (used for fitting and errors) are BRDFs: finite, >= 0, 0 below the horizon."""
+    from brdfkit.render.glsl import parity_vectors
+
+    v = parity_vectors()
+    f = cls(**params).eval(v["wi"].astype(float), v["wo"].astype(float))
+    assert np.isfinite(f).all() and (f >= 0).all()
+    below = (v["wi"][:, 2] <= 0) | (v["wo"][:, 2] <= 0)
+    assert (f[below] == 0).all() and f[~below].max() > 0
+
+
+def test_gltf_formula_independent_point():
+    """GltfPBR at one pair, against the formula written out by hand (glTF 2.0 Appendix B)."""
+    wi = np.array([0.6, 0.0, 0.8])
+    wo = np.array([-0.28, 0.0, 0.96])
+    base, metallic, rough, ior = np.array([0.5, 0.4, 0.3]), 0.25, 0.5, 1.5
+    a = rough**2
+    h = (wi + wo) / np.linalg.norm(wi + wo)
+    nh, nl, nv, vh = h[2], wi[2], wo[2], wo @ h
+    D = a * a / (math.pi * (nh * nh * (a * a - 1) + 1) ** 2)
+    V = 1 / ((nl + math.sqrt(a * a + (1 - a * a) * nl * nl)) * (nv + math.sqrt(a * a + (1 - a * a) * nv * nv)))
+    f0 = ((ior - 1) / (ior + 1)) ** 2
+    F0 = f0 + (base - f0) * metallic
+    F = F0 + (1 - F0) * (1 - vh) ** 5
+    want = (1 - metallic) * (1 - F) * base / math.pi + F * D * V
+    got = GltfPBR(base_color=base, metallic=metallic, roughness=rough, ior=ior).eval(wi, wo)
+    np.testing.assert_allclose(got, want, rtol=1e-12)

@@ -418,18 +418,23 @@ def _openpbr_direct(model: BRDF) -> tuple[dict[str, Any] | None, bool, str]:
         ks = float(np.mean(_rgb(p["ks"])))
         out = {"base_weight": 1.0, "specular_weight": min(ks, 1.0), "specular_roughness": min(r, 1.0),
                "specular_roughness_anisotropy": aniso}
+        if ay > ax:
+            # OpenPBR has no rotation input: its anisotropy runs along the tangent (x)
+            extra = "; OpenPBR has no anisotropy rotation, so alpha_y > alpha_x is written along the tangent"
+        else:
+            extra = ""
         if p["fresnel"] == "conductor":
             f0, tint = conductor_f0_f82(p["eta"], p["k"])
             out.update(base_color=f0.tolist(), base_metalness=1.0, specular_color=tint.tolist())
-            return out, False, "conductor -> metal: base_color = F0(eta, k), specular_color = F82 tint"
+            return out, False, "conductor -> metal: base_color = F0(eta, k), specular_color = F82 tint" + extra
         if p["fresnel"] == "schlick":
             out.update(base_color=_rgb(p["f0"]), base_metalness=1.0, specular_color=[1.0, 1.0, 1.0])
-            return out, False, "schlick conductor -> metal: base_color = f0"
+            return out, False, "schlick conductor -> metal: base_color = f0" + extra
         if p["fresnel"] == "dielectric":
             eta = float(np.mean(_rgb(p["eta"])))
             out.update(base_color=_rgb(p["kd"]), base_metalness=0.0, specular_ior=min(max(eta, 1.0), 5.0),
                        specular_color=[1.0, 1.0, 1.0])
-            return out, False, "dielectric -> base_color = kd, specular_ior = eta"
+            return out, False, "dielectric -> base_color = kd, specular_ior = eta" + extra
     return None, False, ""
 
 
