@@ -103,7 +103,7 @@ def test_parameters_become_params():
     # the wrapped source follows our convention: u_<param> uniforms and brdf(wi, wo)
     for decl in ("uniform float u_alpha;", "uniform vec3 u_f0;", "uniform vec3 u_kd;", "uniform int u_useDiffuse;"):
         assert decl in sh.glsl
-    assert "vec3 brdf(vec3 wi, vec3 wo)" in sh.glsl
+    assert "vec3 brdf(vec3 bk_wi, vec3 bk_wo)" in sh.glsl
     assert "vec3 BRDF( vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y )" in sh.raw_glsl
     # raw_glsl keeps the file's numbering: its line k is line shader_line + k of the file
     file_lines = (DATA / "ggx.brdf").read_text().splitlines()
@@ -193,6 +193,23 @@ def test_malformed_file_one_line_naming_file_and_line(text, pattern):
 def test_well_formed_minimal_file_parses():
     sh = parse_brdf_text(GOOD_HEAD + GOOD_SHADER, name="m.brdf")
     assert [p.name for p in sh.params] == ["a"] and sh.shader_line == 6
+
+
+def test_trailing_comments_and_parameters_named_like_our_arguments():
+    """'# ...' after a parameter line and words after '::begin NAME' are ignored (as BRDF Explorer
+    does); parameters called wi / wo do not clash with the wrapper's own arguments."""
+    from brdfkit.interchange.brdf_explorer import model_class
+
+    text = (
+        "analytic\n::begin parameters   # the sliders\n"
+        "float wi 0 2 1.5   # a weight called wi\n"
+        "float wo 0 2 0.5\n"
+        "::end parameters\n::begin shader\n"
+        "vec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) { return vec3(wi * L.z + wo * V.z); }\n"
+        "::end shader\n"
+    )
+    m = model_class(parse_brdf_text(text, name="names.brdf"))(wi=2.0)
+    np.testing.assert_allclose(m.eval(np.array([0.6, 0.0, 0.8]), np.array([0.0, 0.0, 1.0])), [2.1] * 3, rtol=1e-6)
 
 
 def test_glsl_error_is_one_line_with_the_compiler_message_and_file_line():

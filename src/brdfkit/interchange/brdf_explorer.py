@@ -128,6 +128,10 @@ def _number(name: str, lineno: int, text: str, what: str) -> float:
 
 def _param_line(name: str, lineno: int, line: str, seen: set[str]) -> Param:
     tokens = line.split()
+    for i, t in enumerate(tokens):  # a trailing '# comment'
+        if t.startswith("#"):
+            tokens = tokens[:i]
+            break
     kind = tokens[0]
     forms = {
         "float": "float NAME MIN MAX DEFAULT",
@@ -179,12 +183,12 @@ def _wrap(params: tuple[Param, ...], raw: str, shader_line: int, returns: str, n
     out.append(f"#line {shader_line}")
     out.append(raw.rstrip("\n"))
     out.append("// ---- brdfkit's entry point: local frame N = +z, X = +x, Y = +y; L = wi, V = wo ----")
-    out.append("vec3 brdf(vec3 wi, vec3 wo) {")
-    out.append("    if (wi.z <= 0.0 || wo.z <= 0.0) return vec3(0.0);")
+    out.append("vec3 brdf(vec3 bk_wi, vec3 bk_wo) {")  # prefixed: a parameter may be called wi
+    out.append("    if (bk_wi.z <= 0.0 || bk_wo.z <= 0.0) return vec3(0.0);")
     for p in params:
         rhs = f"(u_{p.name} != 0)" if p.kind == "bool" else f"u_{p.name}"
         out.append(f"    {p.name} = {rhs};")
-    call = "BRDF(wi, wo, vec3(0.0, 0.0, 1.0), vec3(1.0, 0.0, 0.0), vec3(0.0, 1.0, 0.0))"
+    call = "BRDF(bk_wi, bk_wo, vec3(0.0, 0.0, 1.0), vec3(1.0, 0.0, 0.0), vec3(0.0, 1.0, 0.0))"
     out.append(f"    return {'vec3(' + call + ')' if returns == 'float' else call};")
     out.append("}")
     return "\n".join(out) + "\n"
@@ -221,6 +225,8 @@ def parse_brdf_text(text: str, name: str = "<file>") -> BrdfShader:
             if kind != "analytic":
                 raise _err(name, lineno, f"the first line must be 'analytic' (the file's type), got {stripped!r}")
             continue
+        if tokens[0] in ("::begin", "::end"):  # words after the section name are ignored, as BRDF Explorer does
+            tokens = tokens[:2]
         if tokens[0] == "::begin":
             if len(tokens) != 2:
                 raise _err(name, lineno, f"expected '::begin SECTION', got {stripped!r}")
