@@ -74,3 +74,18 @@ def test_fit_result_shows_its_report():
 def test_png_is_deterministic(name):
     m = bk.model(name)
     assert m._repr_png_() == m._repr_png_()
+
+
+def test_ipython_display_formatter_shows_model_and_fit():
+    """IPython's own display machinery (what a Jupyter cell uses) finds the PNG and the HTML."""
+    IPython = pytest.importorskip("IPython")
+    from IPython.core.formatters import DisplayFormatter
+
+    fmt = DisplayFormatter()
+    data, _ = fmt.format(bk.model("microfacet", alpha=0.3))
+    assert {"image/png", "text/html", "text/plain"} <= set(data)
+    assert data["image/png"][:8] == b"\x89PNG\r\n\x1a\n" and "<img" in data["text/html"]
+    r = bk.fit("lambert", bk.model("oren-nayar", kd=0.5, sigma=0.2), samples=300, starts=1)
+    data, _ = fmt.format(r)
+    assert "text/html" in data and "fit of lambert" in data["text/html"]
+    assert IPython.version_info >= (8,)
