@@ -24,8 +24,9 @@ source                                          Mitsuba BSDF                    
                                                 1 − w; reflectances rescaled)
 ``microfacet`` beckmann, smith, conductor       as above                          no: Mitsuba's Beckmann G1 is
                                                                                   Walter's rational approximation
-``microfacet`` smith, dielectric, isotropic     ``roughplastic``                  no: its diffuse term is
-                                                                                  Fresnel-coupled
+``microfacet`` smith, dielectric, isotropic     ``roughplastic`` (the same        no: its diffuse term is
+                                                specular lobe; diffuse_reflectance Fresnel-coupled
+                                                by least squares)
 anything else (other models, other Fresnel /    fitted (:func:`brdfkit.fit`) as   no
 shadowing choices, measured data, .brdf files)  the ggx/smith/conductor
                                                 ``microfacet`` with kd, then the
@@ -351,8 +352,22 @@ def mitsuba_dict(model: BRDF, metric: str = "ngan", data=None) -> tuple[dict[str
                 "nonlinear": False,
             }
             data = data if data is not None else _samples(model)
+            # roughplastic's diffuse lobe is diffuse_reflectance times a Fresnel-transmittance shape
+            # g(wi, wo) (linear in it with nonlinear=false), not kd/π: choose the reflectance by
+            # weighted least squares on the samples, per channel, with g and the specular part
+            # evaluated by Mitsuba itself
+            try:
+                spec = mitsuba_eval(dict(d, diffuse_reflectance={"type": "rgb", "value": [0.0] * 3}), data.wi, data.wo)
+                g = mitsuba_eval(dict(d, diffuse_reflectance={"type": "rgb", "value": [1.0] * 3},
+                                      specular_reflectance={"type": "rgb", "value": [0.0] * 3}), data.wi, data.wo)
+            except ImportError:
+                raise ValueError("measuring this export's error needs Mitsuba 3 (pip install mitsuba)") from None
+            wc2 = data.w[:, None] * data.cos_i[:, None] ** 2
+            rd = np.sum(wc2 * g * (data.f - spec), axis=0) / np.maximum(np.sum(wc2 * g * g, axis=0), 1e-300)
+            d["diffuse_reflectance"] = {"type": "rgb", "value": np.clip(rd, 0.0, 1.0).tolist()}
             info["error"], info["relative_error"] = _mitsuba_errors(d, data, metric)
-            info["note"] = "roughplastic couples its diffuse term to the Fresnel transmittance; error measured in Mitsuba"
+            info["note"] = ("roughplastic: same specular lobe; its diffuse term is Fresnel-coupled, so its "
+                            "diffuse_reflectance is fitted by least squares; error measured in Mitsuba")
             return d, info
     # everything else: the closest ggx/smith/conductor microfacet with a Lambert term, by our fitter
     # (ks free as well, so that kd + ks <= 1 stays reachable: Mitsuba's reflectances must lie in [0, 1])
