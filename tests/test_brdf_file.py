@@ -349,3 +349,13 @@ def test_glsl_es_source_refuses_what_it_cannot_fix():
     m = model_class(sh)()  # fine as desktop GLSL 3.30
     np.testing.assert_allclose(m.eval(np.array([0.6, 0.0, 0.8]), np.array([0.0, 0.0, 1.0])), [0.8] * 3, rtol=1e-6)
     assert glsl_es_source(sh) is None
+
+
+def test_shader_json_is_plain_json_for_the_explorer():
+    from brdfkit.interchange.brdf_explorer import shader_json
+
+    sh = parse_brdf_text((DATA / "ggx.brdf").read_text(), name="ggx.brdf")
+    obj = json.loads(json.dumps(shader_json(sh)))
+    assert [r["name"] for r in obj["params"]] == ["alpha", "f0", "kd", "useDiffuse"]
+    assert obj["params"][0]["min"] == 0.001 and obj["params"][0]["max"] == 1.0 and obj["params"][3]["kind"] == "bool"
+    assert obj["glsl"] == sh.glsl and obj["glsl_es"] == sh.glsl_es and "1.0 - LdotH" in obj["glsl_es"]

@@ -373,3 +373,13 @@ def test_gltf_formula_independent_point():
     want = (1 - metallic) * (1 - F) * base / math.pi + F * D * V
     got = GltfPBR(base_color=base, metallic=metallic, roughness=rough, ior=ior).eval(wi, wo)
     np.testing.assert_allclose(got, want, rtol=1e-12)
+
+
+def test_export_takes_a_fit_result(tmp_path):
+    fit = bk.fit("lambert", bk.model("oren-nayar", kd=0.5, sigma=0.2), samples=300, starts=1)
+    r = bk.export(fit, "gltf", tmp_path / "f.glb")
+    assert r.exact and r.params["base_color"] == pytest.approx(list(fit.params["kd"]))
+    with pytest.raises(ValueError, match="expected a model"):
+        bk.export("lambert", "gltf", tmp_path / "g.glb")
+    with pytest.raises(ValueError, match="unknown export format 'obj'"):
+        bk.export(fit.model, "obj", tmp_path / "g.obj")

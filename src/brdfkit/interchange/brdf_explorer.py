@@ -72,7 +72,7 @@ from ..params import Param
 
 __all__ = [
     "BrdfShader", "parse_brdf_text", "parse_brdf_file", "load_brdf", "load_brdf_class", "BrdfExplorerModel",
-    "promote_int_literals", "rename_builtin_overloads", "glsl_es_source",
+    "promote_int_literals", "rename_builtin_overloads", "glsl_es_source", "shader_json",
 ]
 
 _IDENT = re.compile(r"[A-Za-z_][A-Za-z0-9_]*\Z")
@@ -277,6 +277,21 @@ def parse_brdf_text(text: str, name: str = "<file>") -> BrdfShader:
         kind=kind,
         glsl_es=_wrap(ptuple, promote_int_literals(rename_builtin_overloads(raw)), shader_line, returns, name),
     )
+
+
+def shader_json(shader: BrdfShader) -> dict[str, Any]:
+    """A parsed file as plain JSON values (for the explorer's page): name, the parameter rows
+    (as ``brdfkit info`` shows them), the wrapped GLSL, its ES 3.00 dialect and the raw shader."""
+    return {
+        "name": shader.name,
+        "params": [p.as_row() for p in shader.params],
+        "glsl": shader.glsl,
+        "glsl_es": shader.glsl_es,
+        "raw_glsl": shader.raw_glsl,
+        "shader_line": shader.shader_line,
+        "returns": shader.returns,
+        "has_is_func": bool(shader.is_func),
+    }
 
 
 def parse_brdf_file(path: str | os.PathLike) -> BrdfShader:

@@ -688,6 +688,8 @@ def export(model: BRDF, fmt: str, path: str | os.PathLike, *, metric: str = "nga
         raise ValueError(f"unknown export format {fmt!r}; valid formats: {', '.join(FORMATS)}")
     if metric not in METRICS:
         raise ValueError(f"unknown metric {metric!r}; valid metrics: {', '.join(METRICS)}")
+    if not isinstance(model, BRDF) and isinstance(getattr(model, "model", None), BRDF):
+        model = model.model  # a FitResult: its fitted model
     if not isinstance(model, BRDF):
         raise ValueError(f"export: expected a model, got {type(model).__name__}")
     p = _check_path(path, fmt)
