@@ -79,7 +79,6 @@ from ..models.base import BRDF
 from ..params import to_jsonable
 
 FORMATS = ("mitsuba", "materialx", "gltf")
-EXACT_TOL = 1e-9  # a relative error below this counts as exact (float64 rounding)
 
 
 @dataclass
