@@ -359,3 +359,16 @@ def test_shader_json_is_plain_json_for_the_explorer():
     assert [r["name"] for r in obj["params"]] == ["alpha", "f0", "kd", "useDiffuse"]
     assert obj["params"][0]["min"] == 0.001 and obj["params"][0]["max"] == 1.0 and obj["params"][3]["kind"] == "bool"
     assert obj["glsl"] == sh.glsl and obj["glsl_es"] == sh.glsl_es and "1.0 - LdotH" in obj["glsl_es"]
+
+
+def test_unreadable_files_are_one_line_errors(tmp_path):
+    binary = tmp_path / "bin.brdf"
+    binary.write_bytes(b"\xff\xfe\x00\x81 not text")
+    with pytest.raises(ValueError, match=r"bin\.brdf: not a text file"):
+        bk.load_brdf(binary)
+    with pytest.raises(ValueError, match=r"nope\.brdf: no such \.brdf file"):
+        bk.load_brdf(tmp_path / "nope.brdf")
+    folder = tmp_path / "dir.brdf"
+    folder.mkdir()
+    with pytest.raises(ValueError, match=r"dir\.brdf: no such \.brdf file"):
+        bk.model(str(folder))
