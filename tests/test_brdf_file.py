@@ -372,3 +372,14 @@ def test_unreadable_files_are_one_line_errors(tmp_path):
     folder.mkdir()
     with pytest.raises(ValueError, match=r"dir\.brdf: no such \.brdf file"):
         bk.model(str(folder))
+
+
+def test_check_takes_a_brdf_file():
+    """brdfkit check on Lambert written as a .brdf file: reciprocal, albedo = kd at every angle."""
+    r = _cli("check", str(DATA / "lambert.brdf"), "-p", "kd=0.7", "--json")
+    assert r.returncode == 0, r.stderr
+    out = json.loads(r.stdout)
+    assert out["reciprocal"] is True and out["energy_conserving"] is True
+    assert out["max_albedo"] == pytest.approx(0.7, rel=1e-4)
+    assert max(out["albedo"]["theta_deg"]) >= 89
+    np.testing.assert_allclose(np.asarray(out["albedo"]["rgb"]), 0.7, rtol=1e-4)
