@@ -372,7 +372,12 @@ def mitsuba_dict(model: BRDF, metric: str = "ngan", data=None) -> tuple[dict[str
     # (ks free as well, so that kd + ks <= 1 stays reachable: Mitsuba's reflectances must lie in [0, 1])
     data = data if data is not None else _samples(model)
     fixed = {"distribution": "ggx", "fresnel": "conductor", "shadowing": "smith"}
-    r = _fit(_microfacet_target(model), model, data, metric, fixed)
+    start = None
+    if _is(model, "microfacet"):  # another microfacet variant: its own values are the first start
+        start = {k: p[k] for k in ("alpha_x", "alpha_y", "kd", "ks") if p.get(k) is not None}
+        if p["fresnel"] == "conductor":
+            start.update(eta=p["eta"], k=p["k"])
+    r = _fit(_microfacet_target(model), model, data, metric, fixed, start=start)
     d, clamped = _microfacet_conductor(r.params)
     info.update(method="fit", note=f"fitted as microfacet ggx/smith/conductor + Lambert ({r.n_free} free values)")
     if clamped:
