@@ -88,7 +88,7 @@ def model_png(model: Any) -> bytes:
     """PNG bytes: the lit sphere and the 3D lobe of ``model``."""
     from ..analysis.plots import lobe_plot
 
-    lobe = _fig_rgb(lobe_plot([model], theta_i_deg=45.0, n_theta=30, n_phi=60))
+    lobe = _fig_rgb(lobe_plot([model], theta_i_deg=45.0))
     # the sphere about as tall as the lobe's figure (~400 px at 72 dpi)
     sphere = _sphere_rgb(model, size=max(SPHERE_SIZE, int(lobe.shape[0] * 0.8)))
     return _png(_hstack([sphere, lobe]))
