@@ -383,3 +383,28 @@ def test_check_takes_a_brdf_file():
     assert out["max_albedo"] == pytest.approx(0.7, rel=1e-4)
     assert max(out["albedo"]["theta_deg"]) >= 89
     np.testing.assert_allclose(np.asarray(out["albedo"]["rgb"]), 0.7, rtol=1e-4)
+
+
+def test_bparam_file_gives_the_saved_values(tmp_path):
+    """A parameter file as BRDF Explorer's "Save parameters" writes it: the .brdf it names, with
+    the saved current values (float lines carry MIN MAX VALUE); a name the BRDF lacks is skipped."""
+    text = (
+        f"bparam {DATA / 'ggx.brdf'}\n\n::begin parameters\n"
+        "float alpha 0.001000 1.000000 0.350000\nbool useDiffuse 0\ncolor f0 0.100000 0.200000 0.300000\n"
+        "float gone 0 1 0.5\n::end parameters\n"
+    )
+    (tmp_path / "saved.bparam").write_text(text)
+    m = bk.load_brdf(tmp_path / "saved.bparam")
+    assert m.params["alpha"] == 0.35 and m.params["useDiffuse"] is False
+    np.testing.assert_allclose(m.params["f0"], [0.1, 0.2, 0.3])
+    ref = bk.model("microfacet", alpha=0.35, fresnel="schlick", f0=[0.1, 0.2, 0.3], kd=0.0)
+    wi, wo, _ = _vectors()
+    keep = (wi[:, 2] > 0.05) & (wo[:, 2] > 0.05)
+    np.testing.assert_allclose(m.eval(wi[keep], wo[keep]), ref.eval(wi[keep], wo[keep]), rtol=2e-4, atol=1e-6)
+    assert bk.load_brdf(tmp_path / "saved.bparam", alpha=0.5).params["alpha"] == 0.5
+    # the named file moved: found beside the parameter file, else a one-line error
+    (tmp_path / "moved.bparam").write_text("bparam /nowhere/ggx.brdf\n::begin parameters\n::end parameters\n")
+    with pytest.raises(ValueError, match=r"moved\.bparam: the BRDF it names, '/nowhere/ggx\.brdf', is not found"):
+        bk.load_brdf(tmp_path / "moved.bparam")
+    (tmp_path / "ggx.brdf").write_text((DATA / "ggx.brdf").read_text())
+    assert bk.load_brdf(tmp_path / "moved.bparam").params["alpha"] == 0.2

@@ -72,7 +72,7 @@ from ..params import Param
 
 __all__ = [
     "BrdfShader", "parse_brdf_text", "parse_brdf_file", "load_brdf", "load_brdf_class", "BrdfExplorerModel",
-    "promote_int_literals", "rename_builtin_overloads", "glsl_es_source", "shader_json",
+    "promote_int_literals", "rename_builtin_overloads", "glsl_es_source", "shader_json", "parse_bparam_text",
 ]
 
 _IDENT = re.compile(r"[A-Za-z_][A-Za-z0-9_]*\Z")
@@ -221,7 +221,8 @@ def parse_brdf_text(text: str, name: str = "<file>") -> BrdfShader:
         if kind is None:
             kind = tokens[0]
             if kind == "bparam":
-                raise _err(name, lineno, "this is a BRDF Explorer parameter file ('bparam'), not a BRDF; open the .brdf it names")
+                raise _err(name, lineno, "this is a BRDF Explorer parameter file ('bparam'), not a BRDF; "
+                           "bk.load_brdf reads it together with the .brdf it names")
             if kind != "analytic":
                 raise _err(name, lineno, f"the first line must be 'analytic' (the file's type), got {stripped!r}")
             continue
@@ -512,6 +513,59 @@ def load_brdf_class(path: str | os.PathLike) -> type[BrdfExplorerModel]:
     return cls
 
 
+def parse_bparam_text(text: str, name: str = "<file>") -> tuple[str, dict[str, Any]]:
+    """A BRDF Explorer parameter file (``bparam BRDF_PATH`` and a ``parameters`` section of
+    saved current values, as its "Save parameters" writes it) -> (BRDF path, {name: value})."""
+    lines = text.splitlines()
+    target = None
+    section = None
+    values: dict[str, Any] = {}
+    for lineno, line in enumerate(lines, start=1):
+        stripped = line.strip()
+        if not stripped or stripped.startswith("#"):
+            continue
+        tokens = stripped.split()
+        if target is None:
+            if tokens[0] != "bparam" or len(tokens) < 2:
+                raise _err(name, lineno, f"the first line must be 'bparam PATH_OF_THE_BRDF', got {stripped!r}")
+            target = stripped.split(None, 1)[1]
+            continue
+        if tokens[0] == "::begin" and len(tokens) >= 2:
+            section = tokens[1]
+            continue
+        if tokens[0] == "::end":
+            section = None
+            continue
+        if section == "parameters":
+            p = _param_line(name, lineno, stripped, set(values))
+            values[p.name] = p.default
+    if target is None:
+        raise ValueError(f"{name}: empty file, expected 'bparam PATH_OF_THE_BRDF'")
+    return target, values
+
+
 def load_brdf(path: str | os.PathLike, **params: Any) -> BrdfExplorerModel:
-    """A ``.brdf`` file as a model (parameters validated against the file's ranges)."""
+    """A ``.brdf`` file as a model (parameters validated against the file's ranges).
+
+    A BRDF Explorer parameter file (first line ``bparam PATH``) works too: the ``.brdf`` it
+    names (as written, else beside the parameter file) with the saved values; ``params``
+    override them.
+    """
+    p = Path(path)
+    try:
+        head = p.read_text(encoding="utf-8", errors="replace").lstrip()[:7] if p.is_file() else ""
+    except OSError:
+        head = ""
+    if head.startswith("bparam"):
+        target, saved = parse_bparam_text(p.read_text(encoding="utf-8"), name=str(path))
+        brdf = Path(target)
+        if not brdf.is_file():
+            brdf = p.parent / Path(target).name
+        if not brdf.is_file():
+            raise ValueError(f"{path}: the BRDF it names, {target!r}, is not found (nor beside the parameter file)")
+        cls = load_brdf_class(brdf)
+        known = {q.name for q in cls.spec}
+        saved = {k: v for k, v in saved.items() if k in known}  # as BRDF Explorer syncs them: by name
+        saved.update(params)
+        return cls(**saved)
     return load_brdf_class(path)(**params)
