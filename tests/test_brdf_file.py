@@ -408,3 +408,12 @@ def test_bparam_file_gives_the_saved_values(tmp_path):
         bk.load_brdf(tmp_path / "moved.bparam")
     (tmp_path / "ggx.brdf").write_text((DATA / "ggx.brdf").read_text())
     assert bk.load_brdf(tmp_path / "moved.bparam").params["alpha"] == 0.2
+
+
+def test_crlf_line_ends_and_tabs():
+    from brdfkit.interchange.brdf_explorer import model_class
+
+    text = (DATA / "ggx.brdf").read_text().replace("\n", "\r\n").replace("    ", "\t")
+    m = model_class(parse_brdf_text(text, name="crlf.brdf"))()
+    wi, wo, _ = _vectors()
+    np.testing.assert_array_equal(m.eval(wi, wo), bk.load_brdf(DATA / "ggx.brdf").eval(wi, wo))
