@@ -227,9 +227,39 @@ class Handler(BaseHTTPRequestHandler):
         self._route(head_only=False)
 
     def do_POST(self) -> None:  # noqa: N802
-        self._error(HTTPStatus.METHOD_NOT_ALLOWED, "only GET is supported")
+        # --- explorer (issue 11): POST routes of web/api.py ROUTES ---
+        from . import api
 
-    do_PUT = do_DELETE = do_PATCH = do_POST
+        url = urlsplit(self.path)
+        fn = api.ROUTES.get(("POST", unquote(url.path)))
+        try:
+            n = int(self.headers.get("Content-Length") or 0)
+            if fn is None or n < 0 or n > api.MAX_UPLOAD:
+                self.close_connection = True
+                raise BadRequest("no such POST endpoint" if fn is None else f"body too large ({n} bytes)")
+            self._api_route(fn, url.query, self.rfile.read(n), False)
+        except BadRequest as e:
+            self._error(HTTPStatus.BAD_REQUEST if fn is not None else HTTPStatus.NOT_FOUND, _one_line(e))
+        except BrokenPipeError:  # pragma: no cover - the client went away
+            pass
+        except Exception as e:  # pragma: no cover - a bug: still one line, status 500
+            self._error(HTTPStatus.INTERNAL_SERVER_ERROR, f"internal error: {type(e).__name__}: {_one_line(e)}")
+        # --- end explorer ---
+
+    def do_PUT(self) -> None:  # noqa: N802
+        self._error(HTTPStatus.METHOD_NOT_ALLOWED, "only GET and POST are supported")
+
+    do_DELETE = do_PATCH = do_PUT
+
+    # --- explorer (issue 11): dispatch to web/api.py ROUTES ---
+    def _api_route(self, fn, query: str, body: bytes, head_only: bool) -> None:
+        try:
+            q = parse_qs(query, keep_blank_values=True, max_num_fields=16)
+            status, ctype, payload = fn(q, body)
+        except ValueError as e:
+            raise BadRequest(_one_line(e)) from None
+        self._send(status, payload, ctype, head_only)
+    # --- end explorer ---
 
     def _route(self, head_only: bool) -> None:
         try:
@@ -259,6 +289,8 @@ class Handler(BaseHTTPRequestHandler):
             except ValueError as e:
                 raise BadRequest(f"bad query string: {_one_line(e)}") from None
             self._json(HTTPStatus.OK, eval_payload(q), head_only)
+        elif ("GET", path) in _explorer_routes():  # explorer (issue 11): web/api.py ROUTES
+            self._api_route(_explorer_routes()[("GET", path)], query, b"", head_only)
         else:
             self._error(HTTPStatus.NOT_FOUND, f"no such API endpoint {path!r}; see /api/models, /api/shader/<model>, /api/eval")
 
@@ -276,6 +308,12 @@ class Handler(BaseHTTPRequestHandler):
         if ctype.startswith("text/") or ctype in ("application/javascript",):
             ctype += "; charset=utf-8"
         self._send(HTTPStatus.OK, target.read_bytes(), ctype, head_only)
+
+
+def _explorer_routes() -> dict:  # explorer (issue 11)
+    from . import api
+
+    return api.ROUTES
 
 
 _MODELS_LOCK = threading.Lock()
