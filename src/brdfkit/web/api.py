@@ -35,6 +35,8 @@ Endpoints (all local; nothing here reaches outside the machine):
 ``GET /api/opengl``
     the fixed-function model's twelve materials (:data:`brdfkit.opengl.MATERIALS`) and
     OpenGL's default light.
+``GET /api/validate?model=NAME&params=JSON``
+    ``{"ok": true, "params"}`` or ``{"ok": false, "error"}`` (always status 200).
 ``GET /api/albedo?model=NAME&params=JSON&n=K``
     the directional albedo ρ(θi) at K angles from 0° to 89° by the engine's
     quadrature (:func:`brdfkit.analysis.albedo`, ``over="wo"``).
@@ -268,6 +270,32 @@ def opengl_table(query: dict, body: bytes):
     mats = {name: asdict(m) for name, m in opengl.MATERIALS.items()}
     light = asdict(opengl.Light())
     return _json({"materials": mats, "light": light, "light_model": asdict(opengl.LightModel())})
+
+
+# ---------------------------------------------------------------------------
+# parameter validation (params.py through bk.model): the page checks URL and file values here
+# ---------------------------------------------------------------------------
+@route("GET", "/api/validate")
+def validate_payload(query: dict, body: bytes):
+    """``{"ok": true, "params": effective}`` or ``{"ok": false, "error": one line}`` (status 200 either way:
+    a bad value is an answer here, not a failed request)."""
+    _only(query, {"model", "params"})
+    import brdfkit as bk
+    from ..params import to_jsonable
+    from .server import _jsonable
+
+    name = _one(query, "model")
+    try:
+        params = json.loads(_one(query, "params", "{}"))
+    except json.JSONDecodeError as e:
+        return _json({"ok": False, "error": f"params: not valid JSON ({e.msg})"})
+    if not isinstance(params, dict):
+        return _json({"ok": False, "error": "params: must be a JSON object like {\"kd\": 0.5}"})
+    try:
+        m = bk.model(name, **params)
+    except ValueError as e:
+        return _json({"ok": False, "error": str(e).strip().splitlines()[0]})
+    return _json({"ok": True, "params": _jsonable(to_jsonable(m.params))})
 
 
 # ---------------------------------------------------------------------------

@@ -631,7 +631,7 @@ void main() {
         const map = sliderMap(p);
         const slider = el("input", { type: "range", min: "0", max: String(STEPS), step: "1" });
         const level = el("input", { type: "number", step: "any", title: "the largest channel" });
-        const box = el("span", { class: "rgb" });
+        const box = el("span", { class: "rgb triple" });
         const fields = [0, 1, 2].map((i) => el("input", { type: "number", step: "any", title: "rgb"[i] }));
         let picker = null;
         if (map.lo >= 0 && map.hi <= 1) {
@@ -861,9 +861,9 @@ void main() {
     if (params === null || typeof params !== "object" || Array.isArray(params)) throw new Error(`${model}: params must be a JSON object`);
     await ensureLoaded(model);
     if (kindOf(model) === "analytic") {
-      const q = new URLSearchParams({ model, params: JSON.stringify(params), wi: "0,0,1", wo: "0,0,1" });
-      const r = await fetch("/api/eval?" + q.toString());
-      if (!r.ok) { const b = await r.json(); throw new Error(b.error); }
+      const q = new URLSearchParams({ model, params: JSON.stringify(params) });
+      const b = await fetchJSON("/api/validate?" + q.toString());
+      if (!b.ok) throw new Error(b.error);
     } else if (Object.keys(params).length) {
       throw new Error(`${model}: a measured material has no parameters, got ${Object.keys(params).join(", ")}`);
     }
@@ -895,7 +895,10 @@ void main() {
       panels.length = 0;
       for (const e of good) { const p = addPanel(e.model, e.params); p.setVisible(e.visible); }
     }
-    for (const [k, v] of Object.entries(st.view || {})) {
+    const view = st.view === undefined ? {} : st.view;
+    if (view === null || typeof view !== "object" || Array.isArray(view)) showError(`${origin}: view must be a JSON object`);
+    else for (const [k, v] of Object.entries(DEFAULTS)) if (!(k in view)) setSetting(k, v);  // the state is the whole view
+    for (const [k, v] of Object.entries(view || {})) {
       try { setSetting(k, v); } catch (err) { showError(`${origin}: ${err.message}`); }
     }
     if (st.panes !== undefined) {
