@@ -760,7 +760,7 @@ void main() {
     "obj-att-c": "num", "obj-att-l": "num", "obj-att-q": "num", "obj-local-viewer": "bool",
   };
   const DEFAULTS = {};
-  const orbit = { lobe3d: { yaw: -60, pitch: 25, zoom: 1 }, object: { yaw: 20, pitch: 15, zoom: 1 } };
+  const orbit = { lobe3d: { yaw: -60, pitch: 25, zoom: 1.3 }, object: { yaw: 20, pitch: 15, zoom: 1 } };
   const ORBIT_DEFAULTS = JSON.parse(JSON.stringify(orbit));
 
   function num(id) { return parseFloat($("#" + id).value); }
@@ -1054,10 +1054,10 @@ void main() {
       if (seen.has(c.label)) continue;
       seen.add(c.label);
       ctx.strokeStyle = c.panel.color; ctx.lineWidth = 2; ctx.setLineDash(c.dash || []);
-      ctx.beginPath(); ctx.moveTo(W - 150, y - 4); ctx.lineTo(W - 125, y - 4); ctx.stroke();
+      ctx.beginPath(); ctx.moveTo(W - 215, y - 4); ctx.lineTo(W - 190, y - 4); ctx.stroke();
       ctx.setLineDash([]); ctx.fillStyle = "#333";
-      ctx.fillText(c.label.length > 22 ? c.label.slice(0, 21) + "…" : c.label, W - 120, y);
-      y += 14;
+      ctx.fillText(c.label, W - 185, y, 180);
+      y += 15;
     }
   }
 
@@ -1420,8 +1420,8 @@ void main() {
     });
     list.forEach((panel, i) => {
       ctx.drawImage(glCanvas, i * size, glCanvas.height - size, size, size, T[i].x, 0, size, size);
-      ctx.fillStyle = panel.color; ctx.font = "12px system-ui, sans-serif";
-      ctx.fillText(panel.model, T[i].x + 4, size + 13);
+      ctx.fillStyle = panel.color; ctx.font = "13px system-ui, sans-serif";
+      ctx.fillText(panel.model, T[i].x + 3, size + 14, size - 6);
     });
     viewData.sphere = { tiles: T.slice(0, list.length), models: list.map((p) => p.model) };
   }
@@ -1467,8 +1467,8 @@ void main() {
     });
     list.forEach((panel, i) => {
       ctx.drawImage(glCanvas, i * size, glCanvas.height - size, size, size, T[i].x, 0, size, size);
-      ctx.fillStyle = panel.color; ctx.font = "12px system-ui, sans-serif";
-      ctx.fillText(`${panel.model}  (φd = ${fmt(num("phi-d"))}°)`, T[i].x + 4, size + 13);
+      ctx.fillStyle = panel.color; ctx.font = "13px system-ui, sans-serif";
+      ctx.fillText(`${panel.model}  (φd = ${fmt(num("phi-d"))}°)`, T[i].x + 3, size + 14, size - 6);
     });
     viewData.slice = { tiles: T.slice(0, list.length), models: list.map((p) => p.model) };
   }
