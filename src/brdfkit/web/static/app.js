@@ -1860,6 +1860,8 @@ void main() {
     redraw: () => draw(),
     openFile: (file) => openFile(file),
     meshReady: () => meshReady(),
+    // the older synchronous form: a flat [r, g, b, r, g, b, ...] for lists of directions (analytic models)
+    evaluate: (name, params, wi, wo) => Array.from(evaluateGPU(name, params, flat3(wi), flat3(wo))),
     evaluateNumpy: async (name, params, wi, wo) => Array.from(await evaluateNumpy(name, params, wi, wo)),
     // frames per second of one view drawn into a w x h canvas (gl.finish each frame)
     bench: (view, w, h, frames) => {
