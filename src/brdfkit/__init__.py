@@ -69,3 +69,23 @@ def fit(name: str, measured, fixed=None, metric: str = "ngan", **kw):
 
 
 __all__ += ["load_merl", "save_merl", "material", "materials", "fit"]
+
+
+# -- interchange (brdfkit.interchange; imported on first use) -----------------------
+def load_brdf(path, **params):
+    """A Disney BRDF Explorer ``.brdf`` file as a model (see :mod:`brdfkit.interchange.brdf_explorer`)."""
+    from .interchange.brdf_explorer import load_brdf as _f
+
+    return _f(path, **params)
+
+
+def export(model, fmt: str, path, **kw):
+    """Write ``model`` as a Mitsuba 3 (``"mitsuba"``), MaterialX (``"materialx"``) or glTF (``"gltf"``)
+    material; returns an ExportResult whose ``error`` is the approximation error (None where exact).
+    See :mod:`brdfkit.interchange.export`."""
+    from .interchange.export import export as _f
+
+    return _f(model, fmt, path, **kw)
+
+
+__all__ += ["load_brdf", "export"]

@@ -38,6 +38,7 @@ _PLUGINS: tuple[str, ...] = (
     "brdfkit.measured.commands",
     "brdfkit.render.commands",
     "brdfkit.web.commands",
+    "brdfkit.interchange.commands",
 )
 
 for _mod in _PLUGINS:

@@ -56,6 +56,8 @@ def _measured_from_cli(name: str, items: list[str]):
 
     import brdfkit as bk
 
+    if name.endswith(".brdf"):  # a BRDF Explorer shader: a model with parameters (registry.get)
+        return None
     is_file = os.path.isfile(name) or name.endswith(".binary")
     if not is_file:
         from brdfkit.measured.nbrdf import materials

@@ -36,6 +36,11 @@ def names() -> list[str]:
 def get(name: str) -> type["BRDF"]:
     """The model class for ``name``; ``ValueError`` naming the valid choices otherwise."""
     _ensure_loaded()
+    if isinstance(name, str) and name.endswith(".brdf") and name not in _REGISTRY:
+        # a BRDF Explorer file works wherever a model name does (brdfkit.interchange)
+        from .interchange.brdf_explorer import load_brdf_class
+
+        return load_brdf_class(name)
     if not isinstance(name, str) or name not in _REGISTRY:
         raise ValueError(f"unknown model {name!r}; valid models: {', '.join(_REGISTRY)}")
     return _REGISTRY[name]

@@ -372,6 +372,11 @@ class FitResult:
     def __repr__(self) -> str:
         return f"FitResult({self.model!r}, error={self.error:.6g}, metric={self.metric!r})"
 
+    def _repr_html_(self) -> str:  # Jupyter: the fit's report (brdfkit.interchange.notebook)
+        from ..interchange.notebook import fit_html
+
+        return fit_html(self)
+
 
 def _freeze_unused(packer: ParamPacker, residuals, rng: np.random.Generator) -> None:
     """Freeze slots that change nothing at the defaults nor at a random point (unused options)."""

@@ -135,3 +135,14 @@ class BRDF:
     def __repr__(self) -> str:
         args = ", ".join(f"{k}={v!r}" if not isinstance(v, np.ndarray) else f"{k}={v.tolist()}" for k, v in self.params.items())
         return f"bk.model({self.name!r}, {args})"
+
+    # -- notebook display (the work lives in brdfkit.interchange.notebook) -------------
+    def _repr_png_(self) -> bytes:
+        from ..interchange.notebook import model_png
+
+        return model_png(self)
+
+    def _repr_html_(self) -> str:
+        from ..interchange.notebook import model_html
+
+        return model_html(self)

@@ -138,12 +138,16 @@ def shader_path(model_or_name: Any) -> Path:
     cls = _model_class(model_or_name)
     if is_measured(cls):
         return SHADER_DIR / "measured.glsl"
+    if getattr(cls, "glsl_source", ""):  # a model that carries its own GLSL (a .brdf file)
+        return Path(getattr(cls, "source_path", "") or cls.name)
     module = cls.__module__.rsplit(".", 1)[-1]
     return SHADER_DIR / f"{module}.glsl"
 
 
 def has_shader(model_or_name: Any) -> bool:
-    """Whether the model has a GLSL file."""
+    """Whether the model has a GLSL file (or carries its own source, ``glsl_source``)."""
+    if getattr(_model_class(model_or_name), "glsl_source", ""):
+        return True
     return shader_path(model_or_name).is_file()
 
 
@@ -173,6 +177,9 @@ def shader_source(model_or_name: Any) -> str:
     uniforms. ``ValueError`` if the model has no GLSL file.
     """
     cls = _model_class(model_or_name)
+    own = getattr(cls, "glsl_source", "")
+    if own:  # foreign GLSL wrapped in our convention (brdfkit.interchange.brdf_explorer)
+        return common_source() + f"\n// ---- {cls.name} ----\n" + own
     path = shader_path(cls)
     if not path.is_file():
         raise ValueError(f"model '{cls.name}' has no GLSL implementation (expected {path.name} in {SHADER_DIR})")
