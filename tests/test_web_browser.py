@@ -540,6 +540,7 @@ def test_parameter_file_round_trip_and_bad_file(page, tmp_path):
 # ---------------------------------------------------------------------------
 def test_measured_material_shows(page):
     only(page, "merl/gold-metallic-paint", {}, **{"light-theta": 30, "exposure": 0})
+    page.wait_for_function("window.brdfkit.meshReady()", timeout=30_000)
     for view in ("sphere", "slice", "polar", "object"):
         assert _nonblank(render(page, view)), view
     img = render(page, "sphere")
@@ -575,6 +576,29 @@ def test_dropped_merl_file_shows_and_equals_numpy(page, tmp_path):
     page.set_input_files("#file-input", str(bad))
     page.wait_for_function("window.brdfkit.errors().some(e => e.includes('broken.binary'))", timeout=30_000)
     assert page.evaluate("window.brdfkit.panels.length") == n
+
+
+def test_dropped_brdf_file_shows_and_equals_numpy(page):
+    path = ROOT / "tests" / "data" / "ward.brdf"
+    only(page, "lambert")
+    page.set_input_files("#file-input", str(path))
+    page.wait_for_function("window.brdfkit.panels.some(p => p.model === 'brdf:ward')", timeout=60_000)
+    rows = page.locator("#brdf-list .panel").last.locator(".param")
+    assert [rows.nth(i).get_attribute("data-param") for i in range(rows.count())] == ["kd", "ks", "alpha_x", "alpha_y"]
+    wi, wo = _random_pairs(300, seed=11)
+    wi, wo = wi.astype(np.float32).astype(np.float64), wo.astype(np.float32).astype(np.float64)
+    params = {"kd": 0.3, "alpha_x": 0.2}
+    got = _page_eval(page, "brdf:ward", params, wi, wo)
+    # the file spells Ward 1992: brdfkit's own numpy ward model is an independent reference
+    ref = bk.model("ward", kd=0.3, ks=0.1, alpha_x=0.2, alpha_y=0.3, normalization="ward").eval(wi, wo)
+    _assert_close(got, ref, "ward.brdf")
+    ref2 = bk.load_brdf(path, **params).eval(wi, wo)  # the same file through the renderer's OpenGL
+    _assert_close(got, ref2, "ward.brdf vs load_brdf")
+    page.evaluate("window.brdfkit.panels.forEach(p => p.setVisible(p.model === 'brdf:ward'))")
+    page.wait_for_function("window.brdfkit.meshReady()", timeout=30_000)
+    page.evaluate("window.brdfkit.redraw()")
+    for view in ("sphere", "polar", "object"):
+        assert _nonblank(render(page, view)), view
 
 
 def test_drop_event_loads_a_file(page):

@@ -158,3 +158,18 @@ def test_bad_input_is_400_with_one_line(server, path, needle):
 def test_post_to_an_unknown_path_is_404(server):
     status, body = get_json(server, "/api/nothing", b"x")
     assert status == 404 and "error" in body
+
+
+DATA = __import__("pathlib").Path(__file__).resolve().parent / "data"
+
+
+def test_brdf_file_upload(server):
+    status, body = get_json(server, "/api/brdf?name=ward.brdf", (DATA / "ward.brdf").read_bytes())
+    assert status == 200, body
+    assert body["glsl"].startswith("#version 300 es\n") and "vec3 brdf(vec3 wi, vec3 wo)" in body["glsl"]
+    assert [r["name"] for r in body["info"]["params"]] == ["kd", "ks", "alpha_x", "alpha_y"]
+    assert body["info"]["params"][2]["uniform"] == {"name": "u_alpha_x", "type": "float"}
+    status, body = get_json(server, "/api/brdf?name=broken_glsl.brdf", (DATA / "broken_glsl.brdf").read_bytes())
+    assert status == 400 and "broken_glsl.brdf" in body["error"] and "\n" not in body["error"], body
+    status, body = get_json(server, "/api/brdf?name=x.brdf", b"\xff\xfe\x00")
+    assert status == 400 and "x.brdf" in body["error"]

@@ -32,6 +32,10 @@ Endpoints (all local; nothing here reaches outside the machine):
     read with ``bk.load_merl``; answers ``application/octet-stream``: the table as the
     float32 RGBA texels of ``measured.glsl``'s ``u_table`` (90×90×180×4,
     :func:`brdfkit.render.glsl.table_texels`).
+``POST /api/brdf?name=FILE.brdf`` (body: a Disney BRDF Explorer ``.brdf`` file)
+    parsed by :mod:`brdfkit.interchange.brdf_explorer`; ``{"name", "glsl", "info"}``: its
+    GLSL ES 3.00 (``glsl_es_source``, checked there against the 3.30 original) defining
+    ``brdf()``, and its parameter table in the ``/api/models`` row format.
 ``GET /api/opengl``
     the fixed-function model's twelve materials (:data:`brdfkit.opengl.MATERIALS`) and
     OpenGL's default light.
@@ -47,6 +51,7 @@ from __future__ import annotations
 import json
 import os
 import tempfile
+import threading
 from typing import Callable
 
 import numpy as np
@@ -187,6 +192,83 @@ def merl_upload(query: dict, body: bytes):
     model = _with_temp_file(data, ".binary", bk.load_merl)
     texels = np.ascontiguousarray(glsl.table_texels(model), dtype="<f4")
     return 200, "application/octet-stream", texels.tobytes()
+
+
+# ---------------------------------------------------------------------------
+# Disney BRDF Explorer .brdf files (parsed by brdfkit.interchange)
+# ---------------------------------------------------------------------------
+def _compile_brdf(shader):
+    from ..interchange.brdf_explorer import glsl_es_source, model_class
+
+    cls = model_class(shader)
+    return cls, glsl_es_source(cls)
+
+
+_GL_POOL = None
+_GL_POOL_LOCK = threading.Lock()
+
+
+def _release_current_egl() -> None:
+    """Leave no EGL context current in this thread: the headless context of
+    brdfkit.render.glsl stays current in the thread that last used it, and EGL refuses
+    to make a context current in a second thread while it is current in the first."""
+    from ..render.context import EGLCurrent
+
+    lib = EGLCurrent._egl()
+    if lib is not None and lib.eglGetCurrentContext():
+        lib.eglMakeCurrent(lib.eglGetCurrentDisplay(), None, None, None)
+
+
+def _in_gl_thread(fn):
+    """``fn()`` in the one thread this module does GL work in (GL is not thread-safe;
+    the server answers each request in a thread of its own), the context released after."""
+    global _GL_POOL
+    from concurrent.futures import ThreadPoolExecutor
+
+    with _GL_POOL_LOCK:
+        if _GL_POOL is None:
+            _GL_POOL = ThreadPoolExecutor(max_workers=1, thread_name_prefix="brdfkit-web-gl")
+
+    def job():
+        try:
+            return fn()
+        finally:
+            _release_current_egl()
+
+    return _GL_POOL.submit(job).result()
+
+
+@route("POST", "/api/brdf")
+def brdf_upload(query: dict, body: bytes):
+    """A ``.brdf`` file: ``{"name", "glsl" (GLSL ES 3.00 defining brdf()), "info" (its parameter table)}``."""
+    _only(query, {"name"})
+    import math
+
+    from ..interchange.brdf_explorer import parse_brdf_text
+    from ..render import glsl
+    from .server import _jsonable
+
+    name = os.path.basename(_one(query, "name", "uploaded.brdf"))
+    try:
+        text = _body(body, name).decode("utf-8")
+    except UnicodeDecodeError:
+        raise ValueError(f"{name}: not a text file (a .brdf file is UTF-8 text)") from None
+    cls, es = _in_gl_thread(lambda: _compile_brdf(parse_brdf_text(text, name)))
+    if es is None:
+        raise ValueError(f"{name}: its GLSL does not compile as GLSL ES 3.00 (WebGL 2)")
+    info = cls.info()
+    types = {"scalar": "float", "rgb": "vec3", "bool": "bool", "choice": "int", "int": "int"}
+    by_name = {p.name: p for p in cls.spec}
+    for row in info["params"]:
+        p = by_name[row["name"]]
+        row["log_scale"] = bool(p.log_scale)
+        row["open_lo"] = bool(p.open_lo)
+        row["open_hi"] = bool(p.open_hi)
+        row["uniform"] = {"name": f"u_{p.name}", "type": types.get(p.kind, "float")}
+        for k in ("min", "max"):
+            if isinstance(row.get(k), float) and not math.isfinite(row[k]):
+                row[k] = None
+    return _json({"name": name, "glsl": "#version 300 es\n" + glsl.common_source() + "\n" + es, "info": _jsonable(info)})
 
 
 # ---------------------------------------------------------------------------

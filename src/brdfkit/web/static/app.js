@@ -497,13 +497,14 @@ void main() {
 
   async function loadBrdfFile(file) {
     const text = await file.text();
-    const r = await fetch("/api/brdf", { method: "POST", body: text, headers: { "Content-Type": "text/plain" } });
+    const r = await fetch("/api/brdf?name=" + encodeURIComponent(file.name), { method: "POST", body: text, headers: { "Content-Type": "text/plain" } });
     const body = await r.json().catch(() => ({ error: r.statusText }));
     if (!r.ok) throw new Error(`${file.name}: ${r.status === 404 ? "loading .brdf files is not available in this build" : body.error}`);
     const label = "brdf:" + file.name.replace(/\.brdf$/, "");
     const key = "__brdf:" + label;
-    sources[key] = body.glsl.replace(/^#version[^\n]*\n/, "");
-    brdfFiles[label] = { info: Object.assign({ name: label, title: "Disney BRDF Explorer file", reference: "" }, body.info), key };
+    sources[key] = body.glsl;
+    for (const k of Object.keys(programs)) if (k.startsWith(key + "|")) delete programs[k]; // a file loaded again
+    brdfFiles[label] = { info: Object.assign({ title: "Disney BRDF Explorer file", reference: "" }, body.info, { name: label }), key };
     refreshModelSelects();
     return label;
   }
@@ -864,7 +865,7 @@ void main() {
       const q = new URLSearchParams({ model, params: JSON.stringify(params) });
       const b = await fetchJSON("/api/validate?" + q.toString());
       if (!b.ok) throw new Error(b.error);
-    } else if (Object.keys(params).length) {
+    } else if (kindOf(model) !== "brdf" && Object.keys(params).length) {
       throw new Error(`${model}: a measured material has no parameters, got ${Object.keys(params).join(", ")}`);
     }
     return params;
