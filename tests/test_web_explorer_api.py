@@ -173,3 +173,14 @@ def test_brdf_file_upload(server):
     assert status == 400 and "broken_glsl.brdf" in body["error"] and "\n" not in body["error"], body
     status, body = get_json(server, "/api/brdf?name=x.brdf", b"\xff\xfe\x00")
     assert status == 400 and "x.brdf" in body["error"]
+
+
+def test_brdf_upload_while_this_process_holds_the_gl_context(server):
+    """The headless context stays current in the thread that used it last (here: this one);
+    the upload, answered in a server thread, must still work (it compiles in a child process)."""
+    glsl.eval_glsl("lambert", np.array([[0.0, 0.0, 1.0]]), np.array([[0.0, 0.0, 1.0]]))
+    text = (DATA / "ward.brdf").read_text().replace("float kd 0 1 0.4", "float kd 0 1 0.35")  # not cached
+    status, body = get_json(server, "/api/brdf?name=ward2.brdf", text.encode())
+    assert status == 200, body
+    assert body["info"]["params"][0]["default"] == 0.35
+    glsl.eval_glsl("lambert", np.array([[0.0, 0.0, 1.0]]), np.array([[0.0, 0.0, 1.0]]))  # and this thread still can

@@ -51,7 +51,6 @@ from __future__ import annotations
 import json
 import os
 import tempfile
-import threading
 from typing import Callable
 
 import numpy as np
@@ -197,45 +196,48 @@ def merl_upload(query: dict, body: bytes):
 # ---------------------------------------------------------------------------
 # Disney BRDF Explorer .brdf files (parsed by brdfkit.interchange)
 # ---------------------------------------------------------------------------
-def _compile_brdf(shader):
-    from ..interchange.brdf_explorer import glsl_es_source, model_class
-
-    cls = model_class(shader)
-    return cls, glsl_es_source(cls)
-
-
-_GL_POOL = None
-_GL_POOL_LOCK = threading.Lock()
-
-
-def _release_current_egl() -> None:
-    """Leave no EGL context current in this thread: the headless context of
-    brdfkit.render.glsl stays current in the thread that last used it, and EGL refuses
-    to make a context current in a second thread while it is current in the first."""
-    from ..render.context import EGLCurrent
-
-    lib = EGLCurrent._egl()
-    if lib is not None and lib.eglGetCurrentContext():
-        lib.eglMakeCurrent(lib.eglGetCurrentDisplay(), None, None, None)
+_BRDF_WORKER = r"""
+import json, sys
+sys.path[:0] = json.loads(sys.argv[1])
+from brdfkit.interchange.brdf_explorer import glsl_es_source, model_class, parse_brdf_text
+text = sys.stdin.buffer.read().decode("utf-8")
+try:
+    cls = model_class(parse_brdf_text(text, sys.argv[2]))
+    es = glsl_es_source(cls)
+    out = {"ok": es is not None, "glsl": es, "error": None if es is not None else
+           sys.argv[2] + ": its GLSL does not compile as GLSL ES 3.00 (WebGL 2)"}
+except ValueError as e:
+    out = {"ok": False, "error": (str(e).strip().splitlines() or ["invalid .brdf file"])[0]}
+sys.stdout.write(json.dumps(out))
+"""
+_BRDF_CACHE: dict[str, str] = {}
 
 
-def _in_gl_thread(fn):
-    """``fn()`` in the one thread this module does GL work in (GL is not thread-safe;
-    the server answers each request in a thread of its own), the context released after."""
-    global _GL_POOL
-    from concurrent.futures import ThreadPoolExecutor
+def _brdf_glsl_es(text: str, name: str) -> str:
+    """The GLSL ES 3.00 of a .brdf file, compiled and checked by brdfkit.interchange in a
+    child process: its checks run OpenGL through brdfkit.render.glsl's one headless context,
+    which stays current in the thread that used it last, and the server answers every
+    request in a new thread (and may share its process with other GL users)."""
+    import hashlib
+    import subprocess
+    import sys
 
-    with _GL_POOL_LOCK:
-        if _GL_POOL is None:
-            _GL_POOL = ThreadPoolExecutor(max_workers=1, thread_name_prefix="brdfkit-web-gl")
-
-    def job():
-        try:
-            return fn()
-        finally:
-            _release_current_egl()
-
-    return _GL_POOL.submit(job).result()
+    key = hashlib.blake2b((name + "\0" + text).encode("utf-8"), digest_size=16).hexdigest()
+    if key in _BRDF_CACHE:
+        return _BRDF_CACHE[key]
+    root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    try:
+        r = subprocess.run([sys.executable, "-c", _BRDF_WORKER, json.dumps([root]), name], input=text.encode("utf-8"),
+                           capture_output=True, timeout=120)
+        out = json.loads(r.stdout.decode("utf-8") or "null")
+    except (subprocess.TimeoutExpired, json.JSONDecodeError, OSError):
+        out = None
+    if not isinstance(out, dict):
+        raise ValueError(f"{name}: could not be compiled (the GLSL check failed to run)")
+    if not out["ok"]:
+        raise ValueError(out["error"])
+    _BRDF_CACHE[key] = out["glsl"]
+    return out["glsl"]
 
 
 @route("POST", "/api/brdf")
@@ -253,9 +255,11 @@ def brdf_upload(query: dict, body: bytes):
         text = _body(body, name).decode("utf-8")
     except UnicodeDecodeError:
         raise ValueError(f"{name}: not a text file (a .brdf file is UTF-8 text)") from None
-    cls, es = _in_gl_thread(lambda: _compile_brdf(parse_brdf_text(text, name)))
-    if es is None:
-        raise ValueError(f"{name}: its GLSL does not compile as GLSL ES 3.00 (WebGL 2)")
+    shader = parse_brdf_text(text, name)  # the parse needs no GL: its errors come straight back
+    from ..interchange.brdf_explorer import BrdfExplorerModel
+
+    cls = type("BrdfFile", (BrdfExplorerModel,), {"name": name, "spec": shader.params, "brdf_shader": shader})
+    es = _brdf_glsl_es(text, name)
     info = cls.info()
     types = {"scalar": "float", "rgb": "vec3", "bool": "bool", "choice": "int", "int": "int"}
     by_name = {p.name: p for p in cls.spec}
