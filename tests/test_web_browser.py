@@ -448,6 +448,29 @@ def test_object_view_shadings_fixed_function_and_tessellation(page):
         assert _nonblank(render(page, "object")), mesh
 
 
+def test_object_under_an_environment_map(page):
+    """The renderer's ibl.glsl in the page, progressive: the white furnace gives a Lambert surface
+    exactly its albedo (L_o = kd · 1), a rough conductor under the sky shows."""
+    only(page, "lambert", {"kd": 0.5}, **{"obj-mesh": "sphere", "obj-tess": 32, "obj-material": "brdf:0",
+                                          "obj-lighting": "env:furnace", "exposure": 0, "obj-ibl-spp": 48})
+    page.evaluate("window.brdfkit.show('object', 1)")
+    page.wait_for_function("window.brdfkit.meshReady()", timeout=30_000)
+    page.wait_for_function("window.brdfkit.render('object') && window.brdfkit.iblDone()", timeout=120_000, polling=200)
+    img = render(page, "object")
+    inside = np.abs(img - np.array([23, 23, 26])).max(axis=2) > 10
+    assert inside.sum() > 0.1 * inside.size
+    vals = img[inside]
+    expected = 255 * srgb(0.5)
+    assert abs(np.median(vals) - expected) < 2.0, (np.median(vals), expected)
+    assert np.percentile(np.abs(vals - expected), 90) < 6
+    assert "48 of 48 samples" in page.locator("#object-note").inner_text()
+    only(page, "microfacet", {"alpha": 0.3}, **{"obj-mesh": "sphere", "obj-tess": 32, "obj-material": "brdf:0",
+                                                 "obj-lighting": "env:sky", "obj-ibl-spp": 8})
+    page.wait_for_function("window.brdfkit.render('object') && document.getElementById('object-note').textContent.includes('samples per pixel')",
+                           timeout=120_000, polling=200)
+    assert _nonblank(render(page, "object"))
+
+
 def test_uploaded_obj_shows(page, tmp_path):
     obj = tmp_path / "pyramid.obj"
     obj.write_text("v 0 0 1\nv 1 0 -1\nv -1 1 -1\nv -1 -1 -1\nf 1 2 3\nf 1 3 4\nf 1 4 2\nf 2 4 3\n")

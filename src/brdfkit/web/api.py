@@ -39,6 +39,9 @@ Endpoints (all local; nothing here reaches outside the machine):
 ``GET /api/opengl``
     the fixed-function model's twelve materials (:data:`brdfkit.opengl.MATERIALS`) and
     OpenGL's default light.
+``GET /api/envs``, ``GET /api/env?name=NAME``, ``GET /api/ibl/sampler?model=NAME&params=JSON``
+    the built-in environment maps; one map as the renderer's IBL textures (binary, see
+    :func:`env_payload`); a model's importance-sampling uniforms for ``ibl.glsl``.
 ``GET /api/validate?model=NAME&params=JSON``
     ``{"ok": true, "params"}`` or ``{"ok": false, "error"}`` (always status 200).
 ``GET /api/albedo?model=NAME&params=JSON&n=K``
@@ -356,6 +359,59 @@ def opengl_table(query: dict, body: bytes):
     mats = {name: asdict(m) for name, m in opengl.MATERIALS.items()}
     light = asdict(opengl.Light())
     return _json({"materials": mats, "light": light, "light_model": asdict(opengl.LightModel())})
+
+
+# ---------------------------------------------------------------------------
+# image-based lighting (brdfkit.render.environment / ibl, the renderer's ibl*.glsl)
+# ---------------------------------------------------------------------------
+@route("GET", "/api/envs")
+def env_list(query: dict, body: bytes):
+    _only(query, set())
+    from ..render import environment
+
+    return _json({"environments": dict(environment.BUILTINS)})
+
+
+@route("GET", "/api/env")
+def env_payload(query: dict, body: bytes):
+    """A built-in environment as the renderer's three IBL textures, little-endian binary:
+    int32 ×6 (the rgba, marginal and conditional textures' heights and widths), float32 ×10
+    (world_to_map row-major 3×3, strength), then the float32 texels of the three textures
+    (:func:`brdfkit.render.ibl.env_texture_data`)."""
+    _only(query, {"name"})
+    from ..render import environment, ibl
+
+    name = _one(query, "name")
+    if name not in environment.BUILTINS:
+        raise ValueError(f"unknown environment {name!r}; built-ins: {', '.join(environment.BUILTINS)}")
+    env = environment.Environment(name, environment.builtin_map(name))
+    rgba, marg, cond = ibl.env_texture_data(env)
+    head = np.array([rgba.shape[0], rgba.shape[1], marg.shape[0], marg.shape[1], cond.shape[0], cond.shape[1]], "<i4")
+    extra = np.concatenate([np.asarray(env.world_to_map(), np.float64).reshape(-1), [float(env.strength)]]).astype("<f4")
+    parts = [head.tobytes(), extra.tobytes()] + [np.ascontiguousarray(a, "<f4").tobytes() for a in (rgba, marg, cond)]
+    return 200, "application/octet-stream", b"".join(parts)
+
+
+@route("GET", "/api/ibl/sampler")
+def ibl_sampler(query: dict, body: bytes):
+    """The ``bki_lobe``, ``bki_lobe_params``, ``bki_diffuse_prob`` uniforms of a model's sampler
+    (:func:`brdfkit.render.ibl.sampler_uniforms`)."""
+    _only(query, {"model", "params"})
+    import brdfkit as bk
+    from ..render import ibl
+    from .server import _jsonable
+
+    name = _one(query, "model")
+    try:
+        params = json.loads(_one(query, "params", "{}"))
+    except json.JSONDecodeError as e:
+        raise ValueError(f"params: not valid JSON ({e.msg})") from None
+    if not isinstance(params, dict):
+        raise ValueError("params: must be a JSON object")
+    from ..measured import nbrdf
+
+    m = bk.material(name) if name in nbrdf.materials() else bk.model(name, **params)
+    return _json(_jsonable(ibl.sampler_uniforms(m)))
 
 
 # ---------------------------------------------------------------------------

@@ -286,21 +286,27 @@ void main() {
     for (const f of ["pipeline_lights.glsl", "pipeline_vertex.glsl", "pipeline_fragment.glsl", "pipeline_brdf.glsl", "opengl_fixed.glsl"]) {
       if (F[f] === undefined) throw new Error(`shader file ${f} not loaded`);
     }
-    const where = shading === "phong" ? "fragment" : "vertex";
+    const where = what === "ibl" ? "ibl" : shading === "phong" ? "fragment" : "vertex";
     const defines = [];
     if (shading === "flat") defines.push("#define BKR_FLAT");
-    defines.push(where === "vertex" ? "#define BKR_LIGHT_IN_VERTEX" : "#define BKR_LIGHT_IN_FRAGMENT");
-    // GLSL ES fragment shaders have no default float precision: declare it first
-    const head = "#version 300 es\n" + defines.join("\n") + "\nprecision highp float;\nprecision highp int;\n";
+    defines.push({ vertex: "#define BKR_LIGHT_IN_VERTEX", fragment: "#define BKR_LIGHT_IN_FRAGMENT", ibl: "#define BKR_IBL" }[where]);
+    // GLSL ES fragment shaders have no default float precision: declare it first (and
+    // highp samplers: the environment and the MERL table are float textures)
+    const head = "#version 300 es\n" + defines.join("\n")
+      + "\nprecision highp float;\nprecision highp int;\nprecision highp sampler2D;\nprecision highp sampler3D;\n";
     let body;
     if (what === "gl") body = F["pipeline_lights.glsl"] + F["opengl_fixed.glsl"];
     else {
       const src = sources[key];
       if (src === undefined) throw new Error(`no GLSL source for '${key}'`);
-      body = src.replace(/^#version[^\n]*\n/, "") + F["pipeline_lights.glsl"] + F["pipeline_brdf.glsl"];
+      body = src.replace(/^#version[^\n]*\n/, "") + F["pipeline_lights.glsl"];
+      if (what === "ibl") {
+        if (F["ibl.glsl"] === undefined) throw new Error("this server has no image-based lighting shaders");
+        body += F["ibl_sampling.glsl"] + F["ibl.glsl"];
+      } else body += F["pipeline_brdf.glsl"];
     }
     const vs = head + (where === "vertex" ? body : F["pipeline_lights.glsl"]) + F["pipeline_vertex.glsl"];
-    const fs = head + (where === "fragment" ? body : "") + F["pipeline_fragment.glsl"];
+    const fs = head + (where !== "vertex" ? body : "") + F["pipeline_fragment.glsl"];
     const prog = compileProgram(vs, fs);
     prog._attr = {
       position: gl.getAttribLocation(prog, "in_position"),
@@ -755,7 +761,7 @@ void main() {
     "theta-i": "num", "phi-i": "num", "theta-h": "num", "theta-d": "num", "phi-d": "num", exposure: "num",
     channel: "str", scale: "str", ndotl: "bool",
     "light-theta": "num", "light-phi": "num", tangent: "str", "albedo-method": "str",
-    "obj-mesh": "str", "obj-tess": "num", "obj-shading": "str", "obj-material": "str", "obj-light-type": "str",
+    "obj-mesh": "str", "obj-tess": "num", "obj-lighting": "str", "obj-ibl-spp": "num", "obj-shading": "str", "obj-material": "str", "obj-light-type": "str",
     "obj-light-theta": "num", "obj-light-phi": "num", "obj-light-dist": "num", "obj-light-diffuse": "num",
     "obj-light-specular": "num", "obj-light-ambient": "num", "obj-scene-ambient": "num",
     "obj-att-c": "num", "obj-att-l": "num", "obj-att-q": "num", "obj-local-viewer": "bool",
@@ -1548,6 +1554,8 @@ void main() {
     if (!mesh) return "loading the mesh…";
     const matSel = getSetting("obj-material");
     const shading = getSetting("obj-shading");
+    const lighting = getSetting("obj-lighting");
+    if (lighting.startsWith("env:")) return renderObjectIBL(mesh, w, h, lighting.slice(4), matSel);
     let prog, label, panel = null;
     if (matSel.startsWith("gl:")) {
       prog = getProgram("__opengl", "gl-" + shading);
@@ -1608,6 +1616,143 @@ void main() {
     for (const loc of [A.position, A.normal, A.tangent]) if (loc >= 0) gl.disableVertexAttribArray(loc);
     return `${label} · ${mesh.name}: ${mesh.triangles} triangles, ${mesh.vertices} vertices · ${shading} shading · ${point ? "point" : "directional"} light`;
   }
+  // ---- image-based lighting: the renderer's ibl.glsl, progressive (one pass of IBL_SPP per frame) ----
+  const IBL_SPP = 8;  // samples per pixel per pass, as the renderer's IBL_SPP_PER_PASS
+  const iblMax = () => Math.max(IBL_SPP, Math.round(num("obj-ibl-spp") / IBL_SPP) * IBL_SPP);
+  const envCache = {}, samplerCache = {};
+  const ibl = { key: null, acc: null, spp: 0, fbo: null, color: null, depth: null, w: 0, h: 0, pending: false };
+  function envTextures(name) {
+    if (envCache[name] && envCache[name].tex) return envCache[name];
+    if (!envCache[name]) {
+      envCache[name] = { loading: true };
+      fetch("/api/env?name=" + encodeURIComponent(name)).then(async (r) => {
+        if (!r.ok) throw new Error((await r.json()).error);
+        const buf = await r.arrayBuffer();
+        const head = new Int32Array(buf, 0, 6), extra = new Float32Array(buf, 24, 10);
+        let off = 64;
+        const tex = [[head[0], head[1], 4], [head[2], head[3], 1], [head[4], head[5], 1]].map(([hh, ww, comps]) => {
+          const data = new Float32Array(buf, off, hh * ww * comps);
+          off += hh * ww * comps * 4;
+          const t = gl.createTexture();
+          gl.bindTexture(gl.TEXTURE_2D, t);
+          for (const p of [gl.TEXTURE_MIN_FILTER, gl.TEXTURE_MAG_FILTER]) gl.texParameteri(gl.TEXTURE_2D, p, gl.NEAREST);
+          for (const p of [gl.TEXTURE_WRAP_S, gl.TEXTURE_WRAP_T]) gl.texParameteri(gl.TEXTURE_2D, p, gl.CLAMP_TO_EDGE);
+          gl.texImage2D(gl.TEXTURE_2D, 0, comps === 4 ? gl.RGBA32F : gl.R32F, ww, hh, 0, comps === 4 ? gl.RGBA : gl.RED, gl.FLOAT, data);
+          return t;
+        });
+        envCache[name] = { tex, worldToMap: Array.from(extra.slice(0, 9)), strength: extra[9] };
+        scheduleDraw();
+      }).catch((e) => { envCache[name] = { error: e.message }; showError(`environment ${name}: ${e.message}`); });
+    }
+    return null;
+  }
+  function samplerOf(panel) {
+    const key = panel.model + JSON.stringify(panel.params());
+    if (samplerCache[key] && samplerCache[key].u) return samplerCache[key].u;
+    if (!samplerCache[key]) {
+      samplerCache[key] = { loading: true };
+      const q = new URLSearchParams({ model: panel.model, params: JSON.stringify(panel.params()) });
+      fetchJSON("/api/ibl/sampler?" + q.toString()).then((u) => { samplerCache[key] = { u }; scheduleDraw(); })
+        .catch(() => { samplerCache[key] = { u: { bki_lobe: 0, bki_lobe_params: [0, 0], bki_diffuse_prob: 1 } }; scheduleDraw(); });
+    }
+    return null;
+  }
+  function renderObjectIBL(mesh, w, h, envName, matSel) {
+    if (matSel.startsWith("gl:")) return "image-based lighting needs a BRDF material (the fixed-function model has no environment term)";
+    const i = parseInt(matSel.slice(5), 10);
+    const panel = visiblePanels()[i];
+    if (!panel) return `no visible BRDF number ${i + 1}`;
+    const env = envTextures(envName);
+    const smp = kindOf(panel.model) === "analytic" || kindOf(panel.model) === "nbrdf" ? samplerOf(panel)
+      : { bki_lobe: 0, bki_lobe_params: [0, 0], bki_diffuse_prob: 1 };
+    if (!env || !smp) return "loading the environment…";
+    const st = getState();
+    delete st.view["obj-ibl-spp"]; delete st.view.exposure;  // more samples or another exposure: keep what is there
+    const key = JSON.stringify([st, w, h, mesh.name, mesh.n]);
+    if (key !== ibl.key || ibl.w !== w || ibl.h !== h) {
+      ibl.key = key; ibl.spp = 0; ibl.acc = new Float32Array(w * h * 4);
+      if (ibl.w !== w || ibl.h !== h) {
+        for (const o of [ibl.color]) if (o) gl.deleteTexture(o);
+        if (ibl.depth) gl.deleteRenderbuffer(ibl.depth);
+        if (!ibl.fbo) ibl.fbo = gl.createFramebuffer();
+        ibl.color = makeFloatTexture(w, h, null);
+        ibl.depth = gl.createRenderbuffer();
+        gl.bindRenderbuffer(gl.RENDERBUFFER, ibl.depth);
+        gl.renderbufferStorage(gl.RENDERBUFFER, gl.DEPTH_COMPONENT24, w, h);
+        gl.bindFramebuffer(gl.FRAMEBUFFER, ibl.fbo);
+        gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, ibl.color, 0);
+        gl.framebufferRenderbuffer(gl.FRAMEBUFFER, gl.DEPTH_ATTACHMENT, gl.RENDERBUFFER, ibl.depth);
+        ibl.w = w; ibl.h = h;
+      }
+    }
+    if (ibl.spp < iblMax()) {
+      const prog = getProgram(sourceKey(panel.model), "ibl-phong");
+      gl.bindFramebuffer(gl.FRAMEBUFFER, ibl.fbo);
+      gl.viewport(0, 0, w, h);
+      gl.clearColor(0, 0, 0, 0); gl.clearDepth(1);
+      gl.clear(gl.COLOR_BUFFER_BIT | gl.DEPTH_BUFFER_BIT);
+      gl.useProgram(prog);
+      const M = objectMatrices(w, h);
+      gl.uniformMatrix4fv(U(prog, "bkr_modelview"), false, M.mv);
+      gl.uniformMatrix4fv(U(prog, "bkr_projection"), false, M.proj);
+      gl.uniformMatrix3fv(U(prog, "bkr_normal_matrix"), false, M.nm);
+      bindMaterial(prog, panel.model, panel.params());
+      env.tex.forEach((t, k) => {
+        gl.activeTexture(gl.TEXTURE4 + k); gl.bindTexture(gl.TEXTURE_2D, t);
+        gl.uniform1i(U(prog, ["bki_env", "bki_env_marg", "bki_env_cond"][k]), 4 + k);
+      });
+      gl.activeTexture(gl.TEXTURE0);
+      // eye -> map: the map's rotation after the inverse of the modelview's (a rotation here), as ibl.eye_to_map
+      const R = M.nm, W2M = env.worldToMap; // R column-major 3x3 (eye = R · world); W2M row-major
+      const e2m = new Float32Array(9);  // column-major: e2m[c*3+r] = Σ_k W2M[r][k] · (R^T)[k][c]
+      for (let r = 0; r < 3; r++) for (let c = 0; c < 3; c++) {
+        let sum = 0;
+        for (let k = 0; k < 3; k++) sum += W2M[r * 3 + k] * R[k * 3 + c];  // (R^T)[k][c] = R[c][k] = R_colmajor[k*3 + c]
+        e2m[c * 3 + r] = sum;
+      }
+      gl.uniformMatrix3fv(U(prog, "bki_eye_to_map"), false, e2m);
+      gl.uniform1f(U(prog, "bki_strength"), env.strength);
+      gl.uniform1i(U(prog, "bki_spp"), IBL_SPP);
+      gl.uniform1i(U(prog, "bki_pass"), ibl.spp / IBL_SPP);
+      gl.uniform1i(U(prog, "bki_lobe"), smp.bki_lobe);
+      gl.uniform2fv(U(prog, "bki_lobe_params"), smp.bki_lobe_params);
+      gl.uniform1f(U(prog, "bki_diffuse_prob"), smp.bki_diffuse_prob);
+      const A = prog._attr;
+      for (const [loc, buf] of [[A.position, mesh.pos], [A.normal, mesh.nor], [A.tangent, mesh.tan]]) {
+        if (loc < 0) continue;
+        gl.bindBuffer(gl.ARRAY_BUFFER, buf); gl.enableVertexAttribArray(loc); gl.vertexAttribPointer(loc, 3, gl.FLOAT, false, 0, 0);
+      }
+      gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, mesh.idx);
+      gl.enable(gl.DEPTH_TEST); gl.depthFunc(gl.LESS);
+      gl.drawElements(gl.TRIANGLES, mesh.n, gl.UNSIGNED_INT, 0);
+      gl.disable(gl.DEPTH_TEST);
+      for (const loc of [A.position, A.normal, A.tangent]) if (loc >= 0) gl.disableVertexAttribArray(loc);
+      const img = new Float32Array(w * h * 4);
+      gl.readPixels(0, 0, w, h, gl.RGBA, gl.FLOAT, img);
+      for (let k = 0; k < img.length; k++) ibl.acc[k] += img[k] * IBL_SPP;
+      ibl.spp += IBL_SPP;
+    }
+    // show: mean radiance · 2^exposure, sRGB-encoded (rows flipped: GL's first row is the bottom)
+    const scale = Math.pow(2, num("exposure")) / ibl.spp;
+    const out = new ImageData(w, h);
+    const bg = [0.09, 0.09, 0.1].map((x) => Math.round(x * 255));
+    for (let y = 0; y < h; y++) for (let x = 0; x < w; x++) {
+      const s = 4 * ((h - 1 - y) * w + x), d = 4 * (y * w + x);
+      const cov = ibl.acc[s + 3] > 0;
+      for (let c = 0; c < 3; c++) {
+        const v = ibl.acc[s + c] * scale;
+        out.data[d + c] = cov ? Math.round(255 * linearToSrgb(Math.min(1, Math.max(0, isFinite(v) ? v : 0)))) : bg[c];
+      }
+      out.data[d + 3] = 255;
+    }
+    ibl.image = out;
+    gl.bindFramebuffer(gl.FRAMEBUFFER, null);
+    if (ibl.spp < iblMax()) ibl.pending = true;
+    return `${panel.model} · ${mesh.name} · environment ${envName} (no shadows; the map is not drawn behind) · `
+      + `${ibl.spp} of ${iblMax()} samples per pixel (MIS of the BRDF's sampler and the map's luminance), sRGB`;
+  }
+  const iblDone = () => ibl.spp >= iblMax();
+
   // ρ at normal incidence for the ambient term (pipeline_brdf.glsl's bkr_ambient_albedo), GPU quadrature
   const normalAlbedoCache = {};
   function normalAlbedo(panel) {
@@ -1629,8 +1774,10 @@ void main() {
     const canvas = canvasArg || canvasOf("object");
     const ctx = canvas.getContext("2d");
     let note = "";
+    ibl.image = null;
     try { note = renderObject(canvas.width, canvas.height); } catch (e) { reportDrawError(e); note = "failed: " + e.message; }
-    blit(ctx, canvas.width, canvas.height);
+    if (ibl.image) ctx.putImageData(ibl.image, 0, 0);
+    else blit(ctx, canvas.width, canvas.height);
     $("#object-note").textContent = note;
   }
 
@@ -1640,11 +1787,15 @@ void main() {
   };
   function drawView(name) { if (gl) DRAW[name](); }
 
-  function draw() {
+  function draw(onlyObject) {
     if (!gl) return;
     updateOutputs();
-    for (const v of panes) drawView(v);
+    ibl.pending = false;
+    for (const v of panes) if (!onlyObject || v === "object") drawView(v);
     status.frames += 1;
+    if (ibl.pending && panes.includes("object")) {  // progressive: another pass of the lit object next frame
+      requestAnimationFrame(() => { if (!drawPending) draw(true); });
+    }
   }
 
   // ------------------------------------------------------------------------
@@ -1767,6 +1918,12 @@ void main() {
     const files = ["pipeline_lights.glsl", "pipeline_vertex.glsl", "pipeline_fragment.glsl", "pipeline_brdf.glsl", "opengl_fixed.glsl"];
     const texts = await Promise.all(files.map((f) => fetchText("/api/glsl?file=" + f)));
     files.forEach((f, i) => { shaderFiles[f] = texts[i]; });
+    try {  // image-based lighting: the renderer's ibl*.glsl and the built-in maps
+      const [a, b, envs] = await Promise.all([fetchText("/api/glsl?file=ibl_sampling.glsl"), fetchText("/api/glsl?file=ibl.glsl"),
+        fetchJSON("/api/envs")]);
+      shaderFiles["ibl_sampling.glsl"] = a; shaderFiles["ibl.glsl"] = b;
+      for (const [name, doc] of Object.entries(envs.environments)) $("#obj-lighting").append(el("option", { value: "env:" + name, text: "environment: " + name, title: doc }));
+    } catch (e) { /* a server without image-based lighting: point lights only */ }
     const srcs = await Promise.all(list.map((m) => (m.glsl ? fetchText("/api/shader/" + encodeURIComponent(m.name)).catch(() => null) : null)));
     list.forEach((m, i) => {
       modelInfo[m.name] = m;
@@ -1861,6 +2018,7 @@ void main() {
     redraw: () => draw(),
     openFile: (file) => openFile(file),
     meshReady: () => meshReady(),
+    iblDone: () => iblDone(),
     // the older synchronous form: a flat [r, g, b, r, g, b, ...] for lists of directions (analytic models)
     evaluate: (name, params, wi, wo) => Array.from(evaluateGPU(name, params, flat3(wi), flat3(wo))),
     evaluateNumpy: async (name, params, wi, wo) => Array.from(await evaluateNumpy(name, params, wi, wo)),
