@@ -184,3 +184,30 @@ def test_brdf_upload_while_this_process_holds_the_gl_context(server):
     assert status == 200, body
     assert body["info"]["params"][0]["default"] == 0.35
     glsl.eval_glsl("lambert", np.array([[0.0, 0.0, 1.0]]), np.array([[0.0, 0.0, 1.0]]))  # and this thread still can
+
+
+def test_environment_maps_and_samplers(server):
+    from brdfkit.render import environment, ibl
+
+    status, body = get_json(server, "/api/envs")
+    assert status == 200 and body["environments"] == environment.BUILTINS
+    status, ctype, data = request(server, "/api/env?name=furnace")
+    assert status == 200 and ctype == "application/octet-stream"
+    head = np.frombuffer(data[:24], "<i4")
+    extra = np.frombuffer(data[24:64], "<f4")
+    env = environment.Environment("furnace", environment.builtin_map("furnace"))
+    rgba, marg, cond = ibl.env_texture_data(env)
+    assert list(head) == [*rgba.shape[:2], *marg.shape, *cond.shape]
+    assert np.allclose(extra[:9].reshape(3, 3), env.world_to_map()) and extra[9] == env.strength
+    off = 64
+    for a in (rgba, marg, cond):
+        got = np.frombuffer(data[off:off + a.size * 4], "<f4").reshape(a.shape)
+        assert np.array_equal(got, a)
+        off += a.size * 4
+    assert off == len(data)
+    status, body = get_json(server, "/api/env?name=moon")
+    assert status == 400 and "sky" in body["error"]
+    q = urlencode({"model": "microfacet", "params": json.dumps({"alpha": 0.3, "distribution": "beckmann"})})
+    status, body = get_json(server, "/api/ibl/sampler?" + q)
+    ref = ibl.sampler_uniforms(bk.model("microfacet", alpha=0.3, distribution="beckmann"))
+    assert status == 200 and body["bki_lobe"] == ref["bki_lobe"] and np.allclose(body["bki_lobe_params"], ref["bki_lobe_params"])
