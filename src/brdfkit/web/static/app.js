@@ -1992,12 +1992,7 @@ void main() {
     });
     $("#reset-all").addEventListener("click", () => resetAll());
     const defaultModel = modelInfo.microfacet ? "microfacet" : list[0].name;
-    if (location.search) {
-      let st = null;
-      try { st = urlToState(location.search); } catch (e) { showError(e); }
-      if (st && !st.model) { showError("URL: missing 'model' (the first BRDF's name)"); st.model = undefined; }
-      if (st) await applyState(st, "URL");
-    }
+    if (location.search) await loadURL(location.search);
     if (!panels.length) addPanel(defaultModel, {});
     const bad = Object.entries(status.models).filter(([, s]) => !s.ok).map(([n]) => n);
     setStatus(`${list.length} models + ${measuredNames.length} measured, ${bad.length ? "shader errors: " + bad.join(", ") : "all shaders compiled"} · ${status.renderer}`
@@ -2006,6 +2001,14 @@ void main() {
     draw();
     flushURL();
     status.ready = true;
+  }
+
+  // a URL query (the page's own, or one given by a script) -> the state, errors shown on the page
+  async function loadURL(search) {
+    let st = null;
+    try { st = urlToState(search); } catch (e) { showError(e); }
+    if (st && !st.model) { showError("URL: missing 'model' (the first BRDF's name)"); st.model = undefined; }
+    if (st) await applyState(st, "URL");
   }
 
   function resetAll() {
@@ -2043,6 +2046,7 @@ void main() {
     state: () => getState(),
     setState: (st) => applyState(st, "setState"),
     url: () => flushURL(),
+    loadURL: (search) => loadURL(search),
     show: (view, pane) => { showView(view, pane === undefined ? 0 : pane); draw(); },
     render: (view) => { drawView(view); return canvasOf(view).toDataURL("image/png"); },
     data: (view) => { drawView(view); return viewData[view] || null; },
