@@ -697,7 +697,7 @@ def test_screenshots_for_the_docs(page, tmp_path):
     st = {"model": "microfacet", "params": {"alpha": 0.15}, "compare": [
         {"model": "ward", "params": {"alpha_x": 0.08, "alpha_y": 0.3}}, {"model": "merl/gold-metallic-paint", "params": {}},
         {"model": "oren-nayar", "params": {"sigma": 0.5}}],
-        "panes": ["lobe3d", "sphere"], "view": {"theta-i": 40}}
+        "panes": ["lobe3d", "sphere"], "view": {"theta-i": 40, "scale": "log"}}
     set_state(page, st)
     a = tmp_path / "web_explorer.png"
     page.screenshot(path=str(a))

@@ -2062,16 +2062,18 @@ void main() {
     // the older synchronous form: a flat [r, g, b, r, g, b, ...] for lists of directions (analytic models)
     evaluate: (name, params, wi, wo) => Array.from(evaluateGPU(name, params, flat3(wi), flat3(wo))),
     evaluateNumpy: async (name, params, wi, wo) => Array.from(await evaluateNumpy(name, params, wi, wo)),
-    // frames per second of one view drawn into a w x h canvas (gl.finish each frame)
-    bench: (view, w, h, frames) => {
+    // frames per second of one view drawn into a w x h canvas (gl.finish each frame):
+    // `frames` frames, or fewer (at least 3) once `budgetS` seconds have passed
+    bench: (view, w, h, frames, budgetS) => {
       const c = document.createElement("canvas");
       c.width = w; c.height = h;
       const fn = view === "sphere" ? () => drawSphere(c) : () => drawObject(c);
       fn(); gl.finish();
       const t0 = performance.now();
-      for (let i = 0; i < frames; i++) { fn(); gl.finish(); }
+      let n = 0;
+      while (n < frames && (n < 3 || !budgetS || performance.now() - t0 < 1000 * budgetS)) { fn(); gl.finish(); n++; }
       const dt = (performance.now() - t0) / 1000;
-      return { fps: frames / dt, seconds: dt, frames, width: w, height: h };
+      return { fps: n / dt, seconds: dt, frames: n, width: w, height: h };
     },
   };
   const validatedCache = new Set();
