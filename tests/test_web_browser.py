@@ -674,6 +674,12 @@ def test_png_and_csv_exports(page, tmp_path):
     wo = 2 * np.sum(h * wi, axis=1, keepdims=True) * h - wi
     ref = bk.model("microfacet").eval(wi, wo)
     assert np.allclose(data[:, 1:], ref, rtol=2e-4, atol=1e-6)
+    # the image slice's numbers on its 2° grid, at φd = 90°
+    rows = list(csv.reader(io.StringIO(page.evaluate("window.brdfkit.csv('slice')"))))
+    assert rows[0] == ["theta_h_deg", "theta_d_deg", "microfacet_r", "microfacet_g", "microfacet_b"]
+    data = np.array(rows[1:], dtype=np.float64)
+    assert data.shape == (46 * 46, 5)
+    assert data[np.argmax(data[:, 2]), 0] == 0  # the peak: θh = 0
 
 
 def test_layout_at_1024x768_and_no_outside_requests(browser, page):

@@ -995,7 +995,7 @@ void main() {
       const png = el("button", { type: "button", class: "png", text: "PNG" });
       png.addEventListener("click", () => exportPNG(name));
       bar.append(png);
-      if (!["sphere", "slice", "object"].includes(name)) {
+      if (!["sphere", "object"].includes(name)) {
         const csv = el("button", { type: "button", class: "csv", text: "CSV" });
         csv.addEventListener("click", () => exportCSV(name));
         bar.append(csv);
@@ -1036,9 +1036,22 @@ void main() {
     drawView(name);
     canvasOf(name).toBlob((b) => download(`brdfkit-${name}.png`, b), "image/png");
   }
+  // the slice's numbers: f_r on a 2° grid of (θh, θd) at the current φd, one row per grid point
+  function sliceCSV() {
+    const N = 46, n = N * N, wi = new Float32Array(3 * n), wo = new Float32Array(3 * n), th = [], td = [];
+    for (let a = 0; a < N; a++) for (let b = 0; b < N; b++) {
+      const k = a * N + b;
+      th.push(2 * b); td.push(2 * a);
+      const [x, y] = fromHalfDiff(2 * b * DEG, 2 * a * DEG, num("phi-d") * DEG);
+      wi.set(x, 3 * k); wo.set(y, 3 * k);
+    }
+    const evals = evalPanels(wi, wo, n);
+    return csvFrom(["theta_h_deg", "theta_d_deg"], [th, td], evals, n);
+  }
   function csvText(name) {
     drawView(name);
-    const d = viewData[name];
+    if (name === "slice") viewData.sliceCSV = sliceCSV();
+    const d = name === "slice" ? viewData.sliceCSV : viewData[name];
     if (!d) throw new Error(`view '${name}' has no numbers to export`);
     return [d.header.join(",")].concat(d.rows.map((r) => r.map((x) => (typeof x === "number" ? +x.toPrecision(8) : x)).join(","))).join("\n") + "\n";
   }
