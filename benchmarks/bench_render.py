@@ -16,6 +16,11 @@ texture by ``shaders/measured.glsl``) — two figures:
 ``frame fps``  the whole ``brdfkit.render.render`` call: buffers and framebuffer
                made, drawn, MSAA resolved, read back to numpy, tone-mapped.
 
+Image-based lighting (``--ibl ENV``, default ``studio``; ``''`` to skip): for a few
+materials (``--ibl-models``), the time per sample per pixel of the progressive IBL
+path at the same size (``Renderer.time_ibl_pass``: passes of 8 samples, each one
+BRDF-sampled and one environment-sampled direction with MIS, resolved and read back).
+
 Best of ``--frames`` timed frames after a warm-up. The GL renderer string is
 printed with the table (Mesa llvmpipe on a machine without a GPU). The load
 average is printed too: figures taken on a busy machine are lower bounds.
@@ -43,6 +48,9 @@ def main(argv: list[str] | None = None) -> int:
         help="comma-separated built-in measured materials, rendered through the MERL 3D-texture GLSL "
         "(default: merl/gold-metallic-paint; '' for none)",
     )
+    ap.add_argument("--ibl", default="studio", help="environment for the IBL timing ('' to skip)")
+    ap.add_argument("--ibl-models", default="lambert,microfacet,merl/chrome-steel",
+                    help="comma-separated materials for the IBL timing")
     ap.add_argument("--json", action="store_true")
     args = ap.parse_args(argv)
 
@@ -90,9 +98,22 @@ def main(argv: list[str] | None = None) -> int:
         )
         if not args.json:
             print(f"  {label:20s} draw {1/draw_best:8.2f} fps   frame {1/best:8.2f} fps", file=sys.stderr)
+    ibl_rows = []
+    if args.ibl:
+        from brdfkit.render.environment import environment_from_spec
+
+        env = environment_from_spec(args.ibl)[0]
+        for n in (m for m in args.ibl_models.split(",") if m):
+            mat = bk.material(n) if "/" in n else bk.model(n)
+            scene = make_scene(mesh=mesh, material=mat, shading="phong", size=(args.size, args.size))
+            scene.environment = env
+            per = r.time_ibl_pass(scene, passes=max(1, args.frames))
+            ibl_rows.append({"material": n, "environment": env.name, "size": args.size, "ms_per_sample": per * 1e3})
+            if not args.json:
+                print(f"  IBL {n:20s} {per * 1e3:8.1f} ms per sample per pixel", file=sys.stderr)
     info = r.info
     if args.json:
-        print(json.dumps({"gl": info, "load": os.getloadavg(), "rows": rows}))
+        print(json.dumps({"gl": info, "load": os.getloadavg(), "rows": rows, "ibl": ibl_rows}))
         return 0
     from rich.console import Console
     from rich.table import Table
@@ -110,6 +131,13 @@ def main(argv: list[str] | None = None) -> int:
         )
     con = Console()
     con.print(t)
+    if ibl_rows:
+        ti = Table(title=f"Image-based lighting ({args.ibl}), {args.size}×{args.size}, 4× MSAA: time per sample")
+        for c in ("material", "ms / sample", "s for 64 samples"):
+            ti.add_column(c, justify="right" if c != "material" else "left")
+        for row in ibl_rows:
+            ti.add_row(row["material"], f"{row['ms_per_sample']:.1f}", f"{row['ms_per_sample'] * 64e-3:.1f}")
+        con.print(ti)
     con.print(f"GL: {info['GL_RENDERER']} / {info['GL_VERSION']}; load average {os.getloadavg()[0]:.2f}")
     return 0
 

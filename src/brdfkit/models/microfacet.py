@@ -57,6 +57,7 @@ k               rgb     gold 3.983,2.386,1.603 [0, 20]       imaginary part (con
 f0              rgb     0.967,0.802,0.324      [0, 1]        normal-incidence reflectance (schlick only)
 kd              rgb     0                      [0, 1]        diffuse albedo (kd/π)
 ks              rgb     1                      [0, 1]        specular weight
+multiscatter    bool    false                  true | false  add Kulla-Conty multiple-scattering lobe
 ==============  ======  =====================  ============  ==========================================
 
 The gold indices are the RGB values Mitsuba uses for ``Au``; ``f0`` is gold's
@@ -75,6 +76,7 @@ from ..registry import register
 from ..terms.distributions import distribution as _distribution
 from ..terms.fresnel import fresnel_conductor, fresnel_dielectric_cook, fresnel_schlick
 from ..terms.shadowing import g1_from_lambda, v_groove
+from ..terms import multiscatter as _ms
 from .base import BRDF
 
 GOLD_ETA = (0.143119, 0.374957, 1.442479)
@@ -156,6 +158,9 @@ class Microfacet(BRDF):
         Param("f0", "rgb", GOLD_F0, (0.0, 1.0), "", "normal-incidence reflectance (Schlick Fresnel)"),
         kd_param(0.0),
         ks_param(1.0, "specular weight (scales the microfacet term)"),
+        Param("multiscatter", "bool", False, fit=False,
+              doc="add the energy lost to multiple scattering between facets (Kulla & Conty 2017, "
+                  "Fresnel-weighted; brdfkit.terms.multiscatter)"),
     )
 
     def __init__(self, **params: Any) -> None:
@@ -216,6 +221,9 @@ class Microfacet(BRDF):
         geo = G / (dt.type(4) * np.maximum(cos_i, floor) * np.maximum(cos_o, floor))
         spec = (p["ks"] * F * D[..., None]) * geo[..., None]
         spec = np.minimum(spec, np.finfo(dt).max)
+        if p["multiscatter"]:  # Kulla & Conty 2017 compensation lobe (terms/multiscatter.py)
+            row, scale = _ms.setup(p, lambda mu: fresnel_term(p["fresnel"], mu, p, np.dtype(np.float64)))
+            spec = spec + _ms.multiscatter_term(cos_i, cos_o, row, scale, dt)
         return spec + p["kd"] / dt.type(np.pi)
 
 

@@ -36,7 +36,7 @@ def _floats(text: str, n: tuple[int, ...], what: str) -> list[float]:
 def register(app: typer.Typer) -> None:
     @app.command("render")
     def render_cmd(
-        output: Path = typer.Option(..., "-o", "--output", help="output image: .png (display), .exr or .npy (linear float)"),
+        output: Optional[Path] = typer.Option(None, "-o", "--output", help="output image: .png (display), .exr or .npy (linear float)"),
         scene: Optional[Path] = typer.Option(None, "--scene", help="JSON scene file; the flags below override its fields"),
         model: Optional[str] = typer.Option(None, "--model", "-m", help="a registered BRDF (see `brdfkit list`)"),
         param: Optional[List[str]] = typer.Option(None, "-p", "--param", help="model parameter name=value (repeatable)"),
@@ -57,6 +57,11 @@ def register(app: typer.Typer) -> None:
         exposure: Optional[float] = typer.Option(None, "--exposure", help="linear exposure multiplier"),
         srgb: Optional[bool] = typer.Option(None, "--srgb/--no-srgb", help="sRGB-encode the picture"),
         backend: str = typer.Option("auto", "--backend", help="auto | glsl | numpy"),
+        env: Optional[str] = typer.Option(
+            None, "--env", help="image-based lighting: a built-in environment (see --list-envs) or an .exr/.hdr map"
+        ),
+        samples: Optional[int] = typer.Option(None, "--samples", help="samples per pixel with --env (default 64)"),
+        list_envs: bool = typer.Option(False, "--list-envs", help="list the built-in environments and exit"),
         as_json: bool = typer.Option(False, "--json", help="print what was rendered as JSON"),
     ) -> None:
         """Render a mesh with an OpenGL material or any BRDF (headless OpenGL)."""
@@ -65,7 +70,18 @@ def register(app: typer.Typer) -> None:
         from ..cli_common import model_from_cli
         from . import scene as sc
         from ..fileio import check_output_path
+        from .environment import BUILTINS
         from .image import IMAGE_SUFFIXES
+
+        if list_envs:
+            if as_json:
+                typer.echo(json.dumps([{"name": k, "description": v} for k, v in BUILTINS.items()]))
+            else:
+                for k, v in BUILTINS.items():
+                    typer.echo(f"{k:10s} {v}")
+            return
+        if output is None:
+            raise ValueError("render needs -o/--output (or --list-envs)")
 
         obj: dict[str, Any] = sc.read_scene_file(scene) if scene is not None else {}
         base = scene.parent if scene is not None else None
@@ -113,6 +129,12 @@ def register(app: typer.Typer) -> None:
             obj["srgb"] = srgb
         if material is not None:
             obj["material"] = material  # an object: scene_from_json takes it as it is
+        if env is not None:
+            obj["environment"] = {"name": env} if env in BUILTINS else {"path": str(Path(env).absolute())}
+        if samples is not None:
+            if not isinstance(obj.get("environment"), dict):
+                raise ValueError("--samples needs --env (or an environment in the scene file)")
+            obj["environment"] = {**obj["environment"], "samples": samples}
         # the look: the material's defaults, then the scene file's fields, then the flags (already in obj)
         parsed, look = sc.scene_from_json(obj, base_dir=base)
         check_output_path(output, what="image", suffixes=IMAGE_SUFFIXES, notify=lambda m: typer.echo(f"brdfkit: {m}", err=True))
@@ -131,6 +153,9 @@ def register(app: typer.Typer) -> None:
             "srgb": look.srgb,
             "seconds": round(dt, 4),
         }
+        if parsed.environment is not None:
+            info["environment"] = parsed.environment.name
+            info["samples"] = parsed.samples
         if as_json:
             typer.echo(json.dumps(info))
         else:

@@ -44,6 +44,9 @@ class Panel:
     lights: Sequence[Light] | None = None
     light_model: LightModel | None = None
     exposure: float = 1.0
+    environment: Any = None  # a built-in name or an environment spec: image-based lighting
+    samples: int = 64
+    look: Any = None  # a scene.Look replacing the material's default look (exposure then ignored)
 
 
 @dataclass
@@ -188,6 +191,48 @@ def _ward() -> list[Panel]:
     return out
 
 
+CONDUCTORS = {  # complex refractive index eta + i k at the sRGB primaries (Mitsuba 3's RGB values)
+    "gold": ((0.143119, 0.374957, 1.442479), (3.983160, 2.385721, 1.603215)),
+    "copper": ((0.200438, 0.924033, 1.102212), (3.912949, 2.452848, 2.142188)),
+    "silver": ((0.155265, 0.116723, 0.138342), (4.828181, 3.122249, 2.146961)),
+    "aluminium": ((1.657460, 0.880369, 0.521229), (9.223869, 6.269523, 4.837001)),
+}
+IBL_SAMPLES = 64
+"""Samples per pixel of the gallery's image-based lighting (each: one BRDF and one environment sample)."""
+
+
+def _metals_ibl() -> list[Panel]:
+    import brdfkit as bk
+
+    teapot = {"builtin": "teapot", "subdivisions": 10}
+    out = []
+    for name, (eta, k) in CONDUCTORS.items():
+        m = bk.model("microfacet", alpha=0.12, eta=eta, k=k, multiscatter=True)
+        out.append(Panel(f"{name}, α = 0.12", teapot, m, "phong", TEAPOT_CAM, environment="studio", samples=IBL_SAMPLES))
+    for name in ("merl/chrome-steel", "merl/alum-bronze", "merl/gold-metallic-paint", "merl/blue-metallic-paint"):
+        out.append(Panel(name.split("/", 1)[1] + " (measured)", teapot, bk.material(name), "phong", TEAPOT_CAM,
+                         environment="studio", samples=IBL_SAMPLES))
+    return out
+
+
+FURNACE_ALPHAS = (0.25, 0.5, 0.75, 1.0)
+
+
+def _white_furnace() -> list[Panel]:
+    import brdfkit as bk
+    from .scene import Look
+
+    sphere = {"builtin": "sphere", "segments": 96, "rings": 48}
+    look = Look("clamp", 0.8, True)  # radiance 1 (the furnace) maps to the same grey as the background
+    out = []
+    for ms in (False, True):
+        for a in FURNACE_ALPHAS:
+            m = bk.model("microfacet", alpha=a, fresnel="none", multiscatter=ms)
+            cap = f"α = {a:g}, " + ("multiple scattering" if ms else "single scattering")
+            out.append(Panel(cap, sphere, m, "phong", FRONT, environment="furnace", samples=IBL_SAMPLES, look=look))
+    return out
+
+
 MEASURED = (
     "merl/gold-metallic-paint",
     "merl/blue-metallic-paint",
@@ -221,6 +266,8 @@ FIGURES: dict[str, Figure] = {
         Figure("cook-torrance-metals", "Cook-Torrance (1982) metals, and gold from smooth to rough", 4, _cook_torrance_metals),
         Figure("ward-anisotropic", "Ward's anisotropic (brushed) highlight vs the isotropic one", 3, _ward),
         Figure("measured", "Measured materials (MERL, as Neural-BRDF networks): the table as a 3D texture in GLSL", 6, _measured),
+        Figure("metals-ibl", "Metals (microfacet, complex index) and measured materials in the studio environment", 4, _metals_ibl),
+        Figure("white-furnace", "White furnace (F = 1): single scattering loses energy, Kulla-Conty compensation restores it", 4, _white_furnace),
     )
 }
 
@@ -271,8 +318,14 @@ def render_panel(panel: Panel, size: int, mesh_cache: dict) -> np.ndarray:
         background=(0.0, 0.0, 0.0, 1.0),
         antialias=True,
     )
+    if panel.environment is not None:
+        from .environment import environment_from_spec
+
+        scene.environment = environment_from_spec(panel.environment)[0]
+        scene.samples = panel.samples
+        scene.__post_init__()  # validate the combination
     d = default_look(scene.material)
-    frame = render(scene, Look(d.tonemap, panel.exposure, d.srgb))
+    frame = render(scene, panel.look or Look(d.tonemap, panel.exposure, d.srgb))
     return frame.uint8[..., :3]
 
 
@@ -325,6 +378,8 @@ def run_gallery(out_dir: str | Path, names: Sequence[str] | None = None, size: i
     """Render the figures ``names`` (all by default) into ``out_dir`` as PNG; returns the paths."""
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
+    from ..fileio import atomic_open
+
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     names = list(names) if names else list(FIGURES)
@@ -345,6 +400,7 @@ def run_gallery(out_dir: str | Path, names: Sequence[str] | None = None, size: i
             bar.update(task, description=fig.name)
             img = render_figure(fig, size, lambda: bar.advance(task), mesh_cache, panels)
             path = out / f"{fig.name}.png"
-            img.save(path, optimize=True)
+            with atomic_open(path, "wb") as fh:
+                img.save(fh, format="PNG", optimize=True)
             written.append(path)
     return written

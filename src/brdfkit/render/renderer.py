@@ -72,6 +72,8 @@ class Scene:
     shading: str = "phong"
     background: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 1.0)
     antialias: bool = True
+    environment: Any = None  # an environment.Environment: image-based lighting instead of the lights
+    samples: int = 64  # samples per pixel of the image-based lighting (each one BRDF + one environment sample)
 
     def __post_init__(self) -> None:
         if self.shading not in SHADINGS:
@@ -91,6 +93,16 @@ class Scene:
         if bg.size != 4 or not np.all((bg >= 0) & (bg <= 1)):
             raise ValueError(f"background must be RGB or RGBA in [0, 1], got {self.background!r}")
         self.background = tuple(float(x) for x in bg)  # type: ignore[assignment]
+        if self.environment is not None:
+            from .environment import Environment, check_samples
+
+            if not isinstance(self.environment, Environment):
+                raise ValueError("environment must be an Environment (see brdfkit.render.environment)")
+            self.samples = check_samples(self.samples)
+            if self.is_opengl:
+                raise ValueError("environment lighting needs a BRDF material (a model or a measured one), not an OpenGL material")
+            if self.shading != "phong":
+                raise ValueError(f"environment lighting is per pixel: use shading 'phong', not {self.shading!r}")
 
     @property
     def is_opengl(self) -> bool:
@@ -153,6 +165,8 @@ class Renderer:
             defines.append("#define BKR_VERTEX_COLOR")
         elif where == "gbuffer":
             defines.append("#define BKR_GBUFFER")
+        elif where == "ibl":
+            defines.append("#define BKR_IBL")
         head = "#version 330 core\n" + "\n".join(defines) + "\n"
         if lighting == "opengl":
             light_src = _read_shader("pipeline_lights.glsl") + _read_shader("opengl_fixed.glsl")
@@ -160,12 +174,17 @@ class Renderer:
             from . import glsl
 
             light_src = glsl.shader_source(model) + _read_shader("pipeline_lights.glsl") + _read_shader("pipeline_brdf.glsl")
+        elif lighting == "ibl":
+            from . import glsl
+
+            light_src = (glsl.shader_source(model) + _read_shader("pipeline_lights.glsl")
+                         + _read_shader("ibl_sampling.glsl") + _read_shader("ibl.glsl"))
         else:
             light_src = _read_shader("pipeline_lights.glsl")
         vs = head + (light_src if where == "vertex" else _read_shader("pipeline_lights.glsl")) + _read_shader(
             "pipeline_vertex.glsl"
         )
-        fs = head + (light_src if where == "fragment" else "") + _read_shader("pipeline_fragment.glsl")
+        fs = head + (light_src if where in ("fragment", "ibl") else "") + _read_shader("pipeline_fragment.glsl")
         key = vs + "\x00" + fs
         prog = self._programs.get(key)
         if prog is None:
@@ -358,11 +377,16 @@ class Renderer:
         # Each call makes this context current and afterwards restores the caller's
         # (glcontext's EGL backend leaves the last-entered context current).
         with _EGLCurrent(), self.ctx:
-            if backend == "numpy":
+            if scene.environment is not None:
+                img = self._render_ibl(scene) if backend == "glsl" else self._render_ibl_numpy(scene)
+            elif backend == "numpy":
                 img = self._render_numpy(scene)
             else:
                 img = self._render_glsl(scene)
-        return np.ascontiguousarray(img[::-1])
+        img = np.ascontiguousarray(img[::-1])
+        if scene.environment is not None and scene.environment.visible:
+            img = _over_environment(img, scene)
+        return img
 
     def _lit_program(self, scene: Scene):
         """The GLSL path's program for ``scene``, with every uniform set (shared by rendering and timing)."""
@@ -383,6 +407,141 @@ class Renderer:
         prog = self._lit_program(scene)
         samples = MSAA_SAMPLES if scene.antialias else 0
         return self._draw(prog, scene, scene.size, samples)[0]
+
+    # ------------------------------------------------------------------ image-based lighting
+    def _env_textures(self, env) -> list:
+        """The environment's three textures (radiance+pdf, marginal CDF, conditional CDFs), cached per map."""
+        from .ibl import env_texture_data
+
+        cache = getattr(self, "_env_cache", None)
+        if cache is None:
+            cache = self._env_cache = {}
+        key = (id(env.rgb), env.rgb.shape)
+        hit = cache.get(key)
+        if hit is not None and hit[0] is env.rgb:
+            return hit[1]
+        for _, texs in cache.values():
+            for tex in texs:
+                tex.release()
+        cache.clear()
+        rgba, marg, cond = env_texture_data(env)
+        texs = []
+        for data, comps in ((rgba, 4), (marg, 1), (cond, 1)):
+            tex = self.ctx.texture((data.shape[1], data.shape[0]), comps, np.ascontiguousarray(data).tobytes(), dtype="f4")
+            tex.filter = (self.moderngl.NEAREST, self.moderngl.NEAREST)
+            tex.repeat_x = tex.repeat_y = False
+            texs.append(tex)
+        cache[key] = (env.rgb, texs)
+        return texs
+
+    def _ibl_program(self, scene: Scene):
+        from . import glsl
+        from .ibl import eye_to_map, sampler_uniforms
+
+        if not glsl.has_shader(scene.material):
+            raise ValueError(f"model '{scene.material.name}' has no GLSL file; use backend 'numpy'")
+        prog = self._program("ibl", "ibl", scene.shading, scene.material)
+        self._set_common(prog, scene)
+        self._set_material(prog, scene)
+        env = scene.environment
+        for unit, (name, tex) in enumerate(zip(("bki_env", "bki_env_marg", "bki_env_cond"), self._env_textures(env)), 1):
+            tex.use(location=unit)
+            if name in prog:
+                prog[name].value = unit
+        for name, value in sampler_uniforms(scene.material).items():
+            self._set(prog, name, value)
+        self._set(prog, "bki_eye_to_map", eye_to_map(scene.modelview, env).T)  # column-major for GL
+        self._set(prog, "bki_strength", float(env.strength))
+        return prog
+
+    IBL_SPP_PER_PASS = 8
+
+    def _render_ibl(self, scene: Scene, passes_out: list | None = None) -> np.ndarray:
+        """Progressive accumulation: passes of up to IBL_SPP_PER_PASS samples per pixel, averaged."""
+        prog = self._ibl_program(scene)
+        ctx = self.ctx
+        w, h = scene.size
+        samples = min(MSAA_SAMPLES, ctx.max_samples) if scene.antialias else 0
+        rb = ctx.renderbuffer((w, h), 4, samples=samples, dtype="f4")
+        depth = ctx.depth_renderbuffer((w, h), samples=samples)
+        fbo = ctx.framebuffer(color_attachments=[rb], depth_attachment=depth)
+        res_rb = ctx.renderbuffer((w, h), 4, dtype="f4") if samples else None
+        res = ctx.framebuffer(color_attachments=[res_rb]) if samples else None
+        vao, buffers = self._vao(prog, scene.mesh)
+        acc = np.zeros((h, w, 4), np.float64)
+        try:
+            ctx.viewport = (0, 0, w, h)
+            ctx.enable(self.moderngl.DEPTH_TEST)
+            ctx.disable(self.moderngl.CULL_FACE)
+            ctx.depth_func = "<"
+            done = 0
+            k = 0
+            while done < scene.samples:
+                spp = min(self.IBL_SPP_PER_PASS, scene.samples - done)
+                self._set(prog, "bki_spp", spp)
+                self._set(prog, "bki_pass", k)
+                fbo.use()
+                fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
+                vao.render(self.moderngl.TRIANGLES)
+                if samples:
+                    ctx.copy_framebuffer(res, fbo)
+                    data = res.read(components=4, dtype="f4")
+                else:
+                    data = fbo.read(components=4, dtype="f4")
+                img = np.frombuffer(data, np.float32).reshape(h, w, 4)
+                acc += img * spp
+                if passes_out is not None:
+                    passes_out.append(img.copy())
+                done += spp
+                k += 1
+            return (acc / scene.samples).astype(np.float32)
+        finally:
+            for obj in (vao, fbo, depth, rb, *buffers, *(x for x in (res, res_rb) if x is not None)):
+                obj.release()
+
+    def time_ibl_pass(self, scene: Scene, passes: int = 3) -> float:
+        """Seconds per sample per pixel of the IBL path (``passes`` passes of IBL_SPP_PER_PASS samples,
+        read-back included, after one warm-up pass)."""
+        import dataclasses
+        import time
+
+        warm = dataclasses.replace(scene, samples=1)
+        run = dataclasses.replace(scene, samples=self.IBL_SPP_PER_PASS * passes)
+        with _EGLCurrent(), self.ctx:
+            self._render_ibl(warm)
+            t0 = time.perf_counter()
+            self._render_ibl(run)
+            return (time.perf_counter() - t0) / run.samples
+
+    def gbuffer(self, scene: Scene) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Eye-space position, normal and tangent per pixel ((H, W, 4) each, top row first; alpha = coverage),
+        rasterised without antialiasing — the inputs of per-pixel shading."""
+        with _EGLCurrent(), self.ctx:
+            prog = self._program("none", "gbuffer", "phong")
+            self._set_common(prog, scene)
+            out = self._draw(prog, scene, scene.size, 0, attachments=3)
+        return tuple(np.ascontiguousarray(a[::-1]) for a in out)  # type: ignore[return-value]
+
+    def _render_ibl_numpy(self, scene: Scene) -> np.ndarray:
+        """The brute-force numpy reference (:func:`brdfkit.render.ibl.reference_shade`) on a G-buffer."""
+        from .ibl import reference_shade
+
+        ss = 2 if scene.antialias else 1
+        w, h = scene.size
+        prog = self._program("none", "gbuffer", scene.shading)
+        self._set_common(prog, scene)
+        pos, nrm, tan = self._draw(prog, scene, (w * ss, h * ss), 0, attachments=3)
+        cover = pos[..., 3] > 0
+        img = np.zeros((h * ss, w * ss, 4), np.float64)
+        if cover.any():
+            img[cover, :3] = reference_shade(
+                scene.material, pos[cover][:, :3], nrm[cover][:, :3], tan[cover][:, :3], scene.modelview,
+                scene.environment,
+            )
+            img[cover, 3] = 1.0
+        if ss > 1:
+            img = img.reshape(h, ss, w, ss, 4).mean(axis=(1, 3))
+        return img.astype(np.float32)
 
     def _render_numpy(self, scene: Scene) -> np.ndarray:
         from .lighting import shade_points
@@ -422,6 +581,18 @@ class Renderer:
         if ss > 1:
             img = img.reshape(h, ss, w, ss, 4).mean(axis=(1, 3))
         return img.astype(np.float32)
+
+
+def _over_environment(img: np.ndarray, scene: Scene) -> np.ndarray:
+    """Composite premultiplied ``img`` (top row first) over the environment seen through each pixel."""
+    from .ibl import background_radiance
+
+    bg = background_radiance(scene.projection, scene.modelview, scene.size, scene.environment)
+    out = img.astype(np.float32, copy=True)
+    a = out[..., 3:4]
+    out[..., :3] += ((1.0 - a) * bg).astype(np.float32)
+    out[..., 3] = 1.0
+    return out
 
 
 _DEFAULT: Renderer | None = None

@@ -17,7 +17,9 @@ A scene file (SPEC.md, ``brdfkit render --scene scene.json -o out.png``)::
       "shading": "phong",                        # flat | gouraud | phong
       "background": [0, 0, 0, 1],
       "antialias": true,
-      "tonemap": "aces", "exposure": 1.0, "srgb": true     # optional; defaults depend on the material
+      "tonemap": "aces", "exposure": 1.0, "srgb": true,    # optional; defaults depend on the material
+      "environment": {"name": "sky", "samples": 64}       # optional: image-based lighting instead of
+                                                # the lights; see brdfkit.render.environment
     }
 
 Every field is optional: the defaults are the teapot, the default camera
@@ -57,7 +59,7 @@ from .renderer import Scene, render_linear
 
 SCENE_FIELDS = (
     "mesh", "camera", "size", "lights", "light_model", "material", "shading",
-    "background", "antialias", "tonemap", "exposure", "srgb",
+    "background", "antialias", "tonemap", "exposure", "srgb", "environment",
 )
 OPEN_FIELDS = ("environment",)
 """Scene keys this module accepts without interpreting them (image-based lighting reads ``environment``)."""
@@ -304,6 +306,11 @@ def scene_from_json(obj: Mapping[str, Any], base_dir: str | os.PathLike | None =
         background=obj.get("background", (0.0, 0.0, 0.0, 1.0)),
         antialias=obj.get("antialias", True),
     )
+    if obj.get("environment") is not None:
+        from .environment import environment_from_spec
+
+        env, samples = environment_from_spec(obj["environment"], base_dir=base_dir)
+        scene = Scene(**{**scene.__dict__, "environment": env, "samples": samples or scene.samples})
     look = default_look(scene.material)
     look = Look(  # its errors name tonemap, exposure or srgb
         obj.get("tonemap", look.tonemap),

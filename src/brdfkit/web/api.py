@@ -5,12 +5,501 @@
 The server dispatches to this table after its own routes; a handler raises
 ``ValueError`` for bad input, which the server answers with 400 and the
 one-line message (never a traceback, never a file-system path).
+
+Endpoints (all local; nothing here reaches outside the machine):
+
+``GET /api/measured``
+    ``{"materials": [...]}``: the 159 built-in measured materials (``set/name``).
+``GET /api/nbrdf?name=SET/NAME``
+    ``{"name", "weights"}``: the material's Neural-BRDF network as 675 float32
+    values in the order ``fc1`` (6×21, row-major), ``b1`` (21), ``fc2`` (21×21),
+    ``b2`` (21), ``fc3`` (21×3), ``b3`` (3), padded with one zero to 676 = 169 vec4
+    (``u_nbrdf[169]`` in ``render/shaders/nbrdf.glsl``).
+``GET /api/nbrdf/shader``
+    GLSL ES 3.00 defining ``vec3 brdf(vec3 wi, vec3 wo)`` for a Neural-BRDF network
+    (:func:`nbrdf_source`).
+``GET /api/measured/shader``
+    GLSL ES 3.00 defining ``brdf()`` for a MERL table in a 3D texture (``measured.glsl``).
+``GET /api/glsl?file=NAME.glsl``
+    one file of ``render/shaders`` as text (the page assembles the renderer's pipeline
+    from ``pipeline_*.glsl`` exactly as :mod:`brdfkit.render.renderer` does).
+``GET /api/mesh?name=sphere|torus|plane|teapot&tessellation=N``
+    a built-in mesh of :mod:`brdfkit.render.meshes` as JSON ``{"name", "positions",
+    "normals", "tangents", "faces"}`` (flat lists).
+``POST /api/mesh`` (body: an OBJ file)
+    the same for an uploaded OBJ, read by :func:`brdfkit.render.meshes.load_mesh`.
+``POST /api/merl`` (body: a MERL ``.binary`` file)
+    read with ``bk.load_merl``; answers ``application/octet-stream``: the table as the
+    float32 RGBA texels of ``measured.glsl``'s ``u_table`` (90×90×180×4,
+    :func:`brdfkit.render.glsl.table_texels`).
+``POST /api/brdf?name=FILE.brdf`` (body: a Disney BRDF Explorer ``.brdf`` file)
+    parsed by :mod:`brdfkit.interchange.brdf_explorer`; ``{"name", "glsl", "info"}``: its
+    GLSL ES 3.00 (``glsl_es_source``, checked there against the 3.30 original) defining
+    ``brdf()``, and its parameter table in the ``/api/models`` row format.
+``GET /api/opengl``
+    the fixed-function model's twelve materials (:data:`brdfkit.opengl.MATERIALS`) and
+    OpenGL's default light.
+``GET /api/envs``, ``GET /api/env?name=NAME``, ``GET /api/ibl/sampler?model=NAME&params=JSON``
+    the built-in environment maps; one map as the renderer's IBL textures (binary, see
+    :func:`env_payload`); a model's importance-sampling uniforms for ``ibl.glsl``.
+``GET /api/derived[?model=NAME&params=JSON]``
+    the uniforms a model's GLSL needs beyond one per parameter (the microfacet model's
+    multiple-scattering table), computed by :func:`brdfkit.render.glsl.uniform_values`.
+``GET /api/validate?model=NAME&params=JSON``
+    ``{"ok": true, "params"}`` or ``{"ok": false, "error"}`` (always status 200).
+``GET /api/albedo?model=NAME&params=JSON&n=K``
+    the directional albedo ρ(θi) at K angles from 0° to 89° by the engine's
+    quadrature (:func:`brdfkit.analysis.albedo`, ``over="wo"``).
 """
 
 from __future__ import annotations
 
+import json
+import os
+import tempfile
 from typing import Callable
+
+import numpy as np
 
 Handler = Callable[[dict, bytes], tuple[int, str, bytes]]
 
 ROUTES: dict[tuple[str, str], Handler] = {}
+
+JSON = "application/json; charset=utf-8"
+TEXT = "text/plain; charset=utf-8"
+MAX_UPLOAD = 64 * 1024 * 1024  # a MERL file is 33 MB
+NBRDF_FLOATS = 6 * 21 + 21 + 21 * 21 + 21 + 21 * 3 + 3  # 675
+
+
+def route(method: str, path: str):
+    def deco(fn: Handler) -> Handler:
+        ROUTES[(method, path)] = fn
+        return fn
+
+    return deco
+
+
+def _json(obj) -> tuple[int, str, bytes]:
+    return 200, JSON, json.dumps(obj, separators=(",", ":"), allow_nan=False).encode("utf-8")
+
+
+def _one(query: dict, key: str, default: str | None = None) -> str:
+    v = query.get(key)
+    if not v:
+        if default is None:
+            raise ValueError(f"missing query parameter '{key}'")
+        return default
+    if len(v) > 1:
+        raise ValueError(f"query parameter '{key}' given {len(v)} times; give it once")
+    return v[0]
+
+
+def _only(query: dict, allowed: set[str]) -> None:
+    for k in query:
+        if k not in allowed:
+            raise ValueError(f"unknown query parameter '{k}'; allowed: {', '.join(sorted(allowed))}")
+
+
+def _body(body: bytes, what: str) -> bytes:
+    if not body:
+        raise ValueError(f"{what}: the request body is empty; POST the file's bytes")
+    if len(body) > MAX_UPLOAD:
+        raise ValueError(f"{what}: {len(body)} bytes is more than the {MAX_UPLOAD} allowed")
+    return body
+
+
+def _with_temp_file(body: bytes, suffix: str, fn):
+    """``fn(path)`` on the body written (atomically) to a file in a private temporary folder."""
+    from ..fileio import write_bytes
+
+    with tempfile.TemporaryDirectory(prefix="brdfkit-web-") as d:
+        path = os.path.join(d, "upload" + suffix)
+        write_bytes(path, body)
+        try:
+            return fn(path)
+        except (OSError, ValueError) as e:
+            msg = str(e).replace(path, "the uploaded file").replace(d, "")
+            raise ValueError(msg.strip().splitlines()[0] if msg.strip() else type(e).__name__) from None
+
+
+# ---------------------------------------------------------------------------
+# measured materials
+# ---------------------------------------------------------------------------
+@route("GET", "/api/measured")
+def measured_list(query: dict, body: bytes):
+    _only(query, set())
+    from ..measured import nbrdf
+
+    return _json({"materials": list(nbrdf.materials())})
+
+
+def nbrdf_weights(name: str) -> np.ndarray:
+    """The network of a built-in material as the 676 float32 values ``nbrdf.glsl`` reads."""
+    from ..measured import nbrdf
+
+    full = nbrdf.resolve(name)
+    w = nbrdf._weights()
+    parts = [w[f"{full}/{k}"].astype(np.float32).reshape(-1) for k in ("fc1", "b1", "fc2", "b2", "fc3", "b3")]
+    flat = np.concatenate(parts + [np.zeros(1, np.float32)])
+    if flat.size != NBRDF_FLOATS + 1:
+        raise ValueError(f"{full}: unexpected network shape ({flat.size - 1} weights, expected {NBRDF_FLOATS})")
+    return flat
+
+
+@route("GET", "/api/nbrdf")
+def nbrdf_payload(query: dict, body: bytes):
+    _only(query, {"name"})
+    from ..measured import nbrdf
+
+    name = nbrdf.resolve(_one(query, "name"))
+    return _json({"name": name, "weights": [float(x) for x in nbrdf_weights(name)]})
+
+
+def nbrdf_source() -> str:
+    """GLSL (no ``#version``) defining ``brdf()`` for a Neural-BRDF network.
+
+    common.glsl, then measured.glsl for its Rusinkiewicz angles (``bk_merl_angles``;
+    its own table ``brdf()`` renamed away by a ``#define``), then nbrdf.glsl.
+    """
+    from ..render import glsl
+
+    return (
+        glsl.common_source()
+        + "\n#define brdf bk_merl_table_brdf\n"
+        + glsl.shader_file("measured.glsl")
+        + "\n#undef brdf\n"
+        + glsl.shader_file("nbrdf.glsl")
+    )
+
+
+@route("GET", "/api/nbrdf/shader")
+def nbrdf_shader(query: dict, body: bytes):
+    _only(query, set())
+    return 200, TEXT, ("#version 300 es\n" + nbrdf_source()).encode("utf-8")
+
+
+@route("GET", "/api/measured/shader")
+def measured_shader(query: dict, body: bytes):
+    _only(query, set())
+    from ..render import glsl
+
+    src = glsl.common_source() + "\n" + glsl.shader_file("measured.glsl")
+    return 200, TEXT, ("#version 300 es\n" + src).encode("utf-8")
+
+
+@route("POST", "/api/merl")
+def merl_upload(query: dict, body: bytes):
+    _only(query, set())
+    import brdfkit as bk
+    from ..render import glsl
+
+    data = _body(body, "MERL file")
+    model = _with_temp_file(data, ".binary", bk.load_merl)
+    texels = np.ascontiguousarray(glsl.table_texels(model), dtype="<f4")
+    return 200, "application/octet-stream", texels.tobytes()
+
+
+# ---------------------------------------------------------------------------
+# Disney BRDF Explorer .brdf files (parsed by brdfkit.interchange)
+# ---------------------------------------------------------------------------
+_BRDF_WORKER = r"""
+import json, sys
+sys.path[:0] = json.loads(sys.argv[1])
+from brdfkit.interchange.brdf_explorer import glsl_es_source, model_class, parse_brdf_text
+text = sys.stdin.buffer.read().decode("utf-8")
+try:
+    cls = model_class(parse_brdf_text(text, sys.argv[2]))
+    es = glsl_es_source(cls)
+    out = {"ok": es is not None, "glsl": es, "error": None if es is not None else
+           sys.argv[2] + ": its GLSL does not compile as GLSL ES 3.00 (WebGL 2)"}
+except ValueError as e:
+    out = {"ok": False, "error": (str(e).strip().splitlines() or ["invalid .brdf file"])[0]}
+sys.stdout.write(json.dumps(out))
+"""
+_BRDF_CACHE: dict[str, str] = {}
+
+
+def _brdf_glsl_es(text: str, name: str) -> str:
+    """The GLSL ES 3.00 of a .brdf file, compiled and checked by brdfkit.interchange in a
+    child process: its checks run OpenGL through brdfkit.render.glsl's one headless context,
+    which stays current in the thread that used it last, and the server answers every
+    request in a new thread (and may share its process with other GL users)."""
+    import hashlib
+    import subprocess
+    import sys
+
+    key = hashlib.blake2b((name + "\0" + text).encode("utf-8"), digest_size=16).hexdigest()
+    if key in _BRDF_CACHE:
+        return _BRDF_CACHE[key]
+    root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    try:
+        r = subprocess.run([sys.executable, "-c", _BRDF_WORKER, json.dumps([root]), name], input=text.encode("utf-8"),
+                           capture_output=True, timeout=120)
+        out = json.loads(r.stdout.decode("utf-8") or "null")
+    except (subprocess.TimeoutExpired, json.JSONDecodeError, OSError):
+        out = None
+    if not isinstance(out, dict):
+        raise ValueError(f"{name}: could not be compiled (the GLSL check failed to run)")
+    if not out["ok"]:
+        raise ValueError(out["error"])
+    _BRDF_CACHE[key] = out["glsl"]
+    return out["glsl"]
+
+
+@route("POST", "/api/brdf")
+def brdf_upload(query: dict, body: bytes):
+    """A ``.brdf`` file: ``{"name", "glsl" (GLSL ES 3.00 defining brdf()), "info" (its parameter table)}``."""
+    _only(query, {"name"})
+    import math
+
+    from ..interchange.brdf_explorer import parse_brdf_text
+    from ..render import glsl
+    from .server import _jsonable
+
+    name = os.path.basename(_one(query, "name", "uploaded.brdf"))
+    try:
+        text = _body(body, name).decode("utf-8")
+    except UnicodeDecodeError:
+        raise ValueError(f"{name}: not a text file (a .brdf file is UTF-8 text)") from None
+    shader = parse_brdf_text(text, name)  # the parse needs no GL: its errors come straight back
+    from ..interchange.brdf_explorer import BrdfExplorerModel
+
+    cls = type("BrdfFile", (BrdfExplorerModel,), {"name": name, "spec": shader.params, "brdf_shader": shader})
+    es = _brdf_glsl_es(text, name)
+    info = cls.info()
+    types = {"scalar": "float", "rgb": "vec3", "bool": "bool", "choice": "int", "int": "int"}
+    by_name = {p.name: p for p in cls.spec}
+    for row in info["params"]:
+        p = by_name[row["name"]]
+        row["log_scale"] = bool(p.log_scale)
+        row["open_lo"] = bool(p.open_lo)
+        row["open_hi"] = bool(p.open_hi)
+        row["uniform"] = {"name": f"u_{p.name}", "type": types.get(p.kind, "float")}
+        for k in ("min", "max"):
+            if isinstance(row.get(k), float) and not math.isfinite(row[k]):
+                row[k] = None
+    return _json({"name": name, "glsl": "#version 300 es\n" + glsl.common_source() + "\n" + es, "info": _jsonable(info)})
+
+
+# ---------------------------------------------------------------------------
+# shaders, meshes, the fixed-function table
+# ---------------------------------------------------------------------------
+@route("GET", "/api/glsl")
+def glsl_file(query: dict, body: bytes):
+    _only(query, {"file"})
+    from ..render import glsl
+
+    name = _one(query, "file")
+    files = sorted(p.name for p in glsl.SHADER_DIR.glob("*.glsl"))
+    if name not in files:
+        raise ValueError(f"no shader file {name!r}; available: {', '.join(files)}")
+    return 200, TEXT, glsl.shader_file(name).encode("utf-8")
+
+
+MESH_TESSELLATION = (2, 256)
+
+
+def _mesh_json(mesh) -> tuple[int, str, bytes]:
+    def flat(a, dtype=np.float32):
+        return np.asarray(a, dtype=dtype).reshape(-1).tolist()
+
+    return _json({
+        "name": mesh.name,
+        "positions": [round(x, 6) for x in flat(mesh.positions)],
+        "normals": [round(x, 6) for x in flat(mesh.normals)],
+        "tangents": [round(x, 6) for x in flat(mesh.tangents)],
+        "faces": flat(mesh.faces, np.int64),
+    })
+
+
+@route("GET", "/api/mesh")
+def mesh_builtin(query: dict, body: bytes):
+    _only(query, {"name", "tessellation"})
+    from ..render import meshes
+
+    name = _one(query, "name")
+    text = _one(query, "tessellation", "32")
+    try:
+        t = int(text)
+    except ValueError:
+        raise ValueError(f"tessellation must be an integer, got {text!r}") from None
+    lo, hi = MESH_TESSELLATION
+    if not lo <= t <= hi:
+        raise ValueError(f"tessellation {t} is out of range; allowed [{lo}, {hi}]")
+    kwargs = {
+        "sphere": {"segments": 2 * t, "rings": t},
+        "torus": {"segments": 2 * t, "sides": t},
+        "plane": {"divisions": t},
+        "teapot": {"subdivisions": max(1, t // 3)},
+    }
+    if name not in kwargs:
+        raise ValueError(f"unknown built-in mesh {name!r}; valid: {', '.join(kwargs)}")
+    return _mesh_json(meshes.builtin(name, **kwargs[name]))
+
+
+@route("POST", "/api/mesh")
+def mesh_upload(query: dict, body: bytes):
+    _only(query, set())
+    from ..render import meshes
+
+    data = _body(body, "OBJ file")
+    mesh = _with_temp_file(data, ".obj", meshes.load_mesh)
+    import dataclasses
+
+    mesh = dataclasses.replace(mesh, name="uploaded OBJ")
+    if mesh.n_triangles > 2_000_000:
+        raise ValueError(f"OBJ file: {mesh.n_triangles} triangles is more than the 2000000 allowed")
+    return _mesh_json(mesh)
+
+
+@route("GET", "/api/opengl")
+def opengl_table(query: dict, body: bytes):
+    _only(query, set())
+    from dataclasses import asdict
+
+    from .. import opengl
+
+    mats = {name: asdict(m) for name, m in opengl.MATERIALS.items()}
+    light = asdict(opengl.Light())
+    return _json({"materials": mats, "light": light, "light_model": asdict(opengl.LightModel())})
+
+
+# ---------------------------------------------------------------------------
+# image-based lighting (brdfkit.render.environment / ibl, the renderer's ibl*.glsl)
+# ---------------------------------------------------------------------------
+@route("GET", "/api/envs")
+def env_list(query: dict, body: bytes):
+    _only(query, set())
+    from ..render import environment
+
+    return _json({"environments": dict(environment.BUILTINS)})
+
+
+@route("GET", "/api/env")
+def env_payload(query: dict, body: bytes):
+    """A built-in environment as the renderer's three IBL textures, little-endian binary:
+    int32 ×6 (the rgba, marginal and conditional textures' heights and widths), float32 ×10
+    (world_to_map row-major 3×3, strength), then the float32 texels of the three textures
+    (:func:`brdfkit.render.ibl.env_texture_data`)."""
+    _only(query, {"name"})
+    from ..render import environment, ibl
+
+    name = _one(query, "name")
+    if name not in environment.BUILTINS:
+        raise ValueError(f"unknown environment {name!r}; built-ins: {', '.join(environment.BUILTINS)}")
+    env = environment.Environment(name, environment.builtin_map(name))
+    rgba, marg, cond = ibl.env_texture_data(env)
+    head = np.array([rgba.shape[0], rgba.shape[1], marg.shape[0], marg.shape[1], cond.shape[0], cond.shape[1]], "<i4")
+    extra = np.concatenate([np.asarray(env.world_to_map(), np.float64).reshape(-1), [float(env.strength)]]).astype("<f4")
+    parts = [head.tobytes(), extra.tobytes()] + [np.ascontiguousarray(a, "<f4").tobytes() for a in (rgba, marg, cond)]
+    return 200, "application/octet-stream", b"".join(parts)
+
+
+@route("GET", "/api/ibl/sampler")
+def ibl_sampler(query: dict, body: bytes):
+    """The ``bki_lobe``, ``bki_lobe_params``, ``bki_diffuse_prob`` uniforms of a model's sampler
+    (:func:`brdfkit.render.ibl.sampler_uniforms`)."""
+    _only(query, {"model", "params"})
+    import brdfkit as bk
+    from ..render import ibl
+    from .server import _jsonable
+
+    name = _one(query, "model")
+    try:
+        params = json.loads(_one(query, "params", "{}"))
+    except json.JSONDecodeError as e:
+        raise ValueError(f"params: not valid JSON ({e.msg})") from None
+    if not isinstance(params, dict):
+        raise ValueError("params: must be a JSON object")
+    from ..measured import nbrdf
+
+    m = bk.material(name) if name in nbrdf.materials() else bk.model(name, **params)
+    return _json(_jsonable(ibl.sampler_uniforms(m)))
+
+
+# ---------------------------------------------------------------------------
+# derived uniforms (uniforms a model's GLSL declares beyond one per parameter)
+# ---------------------------------------------------------------------------
+@route("GET", "/api/derived")
+def derived_uniforms(query: dict, body: bytes):
+    """Without ``model``: ``{"models": {name: {uniform: type}}}`` (glsl.DERIVED_UNIFORMS);
+    with ``model`` and ``params``: ``{"uniforms": {name: value}}`` from glsl.uniform_values."""
+    _only(query, {"model", "params"})
+    import brdfkit as bk
+    from ..render import glsl
+    from .server import _jsonable
+
+    table = getattr(glsl, "DERIVED_UNIFORMS", {})
+    if "model" not in query:
+        return _json({"models": table})
+    name = _one(query, "model")
+    try:
+        params = json.loads(_one(query, "params", "{}"))
+    except json.JSONDecodeError as e:
+        raise ValueError(f"params: not valid JSON ({e.msg})") from None
+    if not isinstance(params, dict):
+        raise ValueError("params: must be a JSON object")
+    values = glsl.uniform_values(bk.model(name, **params))
+    names = table.get(name, {})
+    return _json({"uniforms": _jsonable({k: v for k, v in values.items() if k in names})})
+
+
+# ---------------------------------------------------------------------------
+# parameter validation (params.py through bk.model): the page checks URL and file values here
+# ---------------------------------------------------------------------------
+@route("GET", "/api/validate")
+def validate_payload(query: dict, body: bytes):
+    """``{"ok": true, "params": effective}`` or ``{"ok": false, "error": one line}`` (status 200 either way:
+    a bad value is an answer here, not a failed request)."""
+    _only(query, {"model", "params"})
+    import brdfkit as bk
+    from ..params import to_jsonable
+    from .server import _jsonable
+
+    name = _one(query, "model")
+    try:
+        params = json.loads(_one(query, "params", "{}"))
+    except json.JSONDecodeError as e:
+        return _json({"ok": False, "error": f"params: not valid JSON ({e.msg})"})
+    if not isinstance(params, dict):
+        return _json({"ok": False, "error": "params: must be a JSON object like {\"kd\": 0.5}"})
+    try:
+        m = bk.model(name, **params)
+    except ValueError as e:
+        return _json({"ok": False, "error": str(e).strip().splitlines()[0]})
+    return _json({"ok": True, "params": _jsonable(to_jsonable(m.params))})
+
+
+# ---------------------------------------------------------------------------
+# albedo by the engine (the page's own is GPU quadrature)
+# ---------------------------------------------------------------------------
+@route("GET", "/api/albedo")
+def albedo_payload(query: dict, body: bytes):
+    _only(query, {"model", "params", "n"})
+    import brdfkit as bk
+    from ..analysis import albedo
+
+    name = _one(query, "model")
+    try:
+        params = json.loads(_one(query, "params", "{}"))
+    except json.JSONDecodeError as e:
+        raise ValueError(f"params: not valid JSON ({e.msg})") from None
+    if not isinstance(params, dict):
+        raise ValueError("params: must be a JSON object like {\"kd\": 0.5}")
+    text = _one(query, "n", "30")
+    try:
+        n = int(text)
+    except ValueError:
+        raise ValueError(f"n must be an integer, got {text!r}") from None
+    if not 2 <= n <= 200:
+        raise ValueError(f"n {n} is out of range; allowed [2, 200]")
+    m = bk.material(name) if "/" in name else bk.model(name, **params)
+    theta = np.radians(np.linspace(0.0, 89.0, n))
+    rho = np.asarray(albedo(m, theta, over="wo", level="fast", include_delta=False), dtype=np.float64)
+    rho = np.where(np.isfinite(rho), rho, 0.0)
+    return _json({
+        "model": name,
+        "theta_deg": np.degrees(theta).tolist(),
+        "rgb": rho.tolist(),
+        "method": "brdfkit.analysis.albedo (engine quadrature, level=fast, mirror part excluded)",
+    })

@@ -13,6 +13,26 @@ uniform vec3 u_k;
 uniform vec3 u_f0;
 uniform vec3 u_kd;
 uniform vec3 u_ks;
+uniform int u_multiscatter;   // 1: add the Kulla-Conty multiple-scattering lobe
+// Derived uniforms (brdfkit/terms/multiscatter.py, set by render/glsl.py): the missing energy
+// 1 - E(mu_j) of the albedo table at this alpha (nodes uniform in mu on [0, 1]) and
+// ks * F-weight / (pi (1 - E_avg)).
+#define BK_MS_N 33
+uniform float u_ms_missing[BK_MS_N];
+uniform vec3 u_ms_scale;
+
+// 1 - E(mu): linear between the row's nodes (numpy: terms/multiscatter.py albedo_lookup).
+float microfacet_ms_missing(float mu) {
+    float s = clamp(mu, 0.0, 1.0) * float(BK_MS_N - 1);
+    int i = min(int(floor(s)), BK_MS_N - 2);
+    float t = s - float(i);
+    return u_ms_missing[i] * (1.0 - t) + u_ms_missing[i + 1] * t;
+}
+
+// Kulla & Conty 2017: scale (1 - E(mu_i)) (1 - E(mu_o)), symmetric in wi and wo.
+vec3 microfacet_multiscatter(float cos_i, float cos_o) {
+    return u_ms_scale * (microfacet_ms_missing(cos_i) * microfacet_ms_missing(cos_o));
+}
 
 vec3 microfacet_fresnel(float c) {
     if (u_fresnel == 0) return fresnel_conductor(c, u_eta, u_k);
@@ -46,5 +66,6 @@ vec3 brdf(vec3 wi, vec3 wo) {
     vec3 F = microfacet_fresnel(c);
     float geo = G / (4.0 * max(cos_i, 1e-18) * max(cos_o, 1e-18));
     vec3 spec = min((u_ks * F * D) * geo, vec3(BK_FLT_MAX));
+    if (u_multiscatter != 0) spec += microfacet_multiscatter(cos_i, cos_o);
     return spec + u_kd / BK_PI;
 }
