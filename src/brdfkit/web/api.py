@@ -68,7 +68,44 @@ ROUTES: dict[tuple[str, str], Handler] = {}
 JSON = "application/json; charset=utf-8"
 TEXT = "text/plain; charset=utf-8"
 MAX_UPLOAD = 64 * 1024 * 1024  # a MERL file is 33 MB
-NBRDF_FLOATS = 6 * 21 + 21 + 21 * 21 + 21 + 21 * 3 + 3  # 675
+
+
+def _refuse(name) -> None:
+    if not isinstance(name, str):
+        raise ValueError("model: must be a name")
+    if name.endswith((".brdf", ".binary")) or name.count("/") > 1 or name.startswith((".", "/", "~")):
+        raise ValueError("model: a name is expected; file paths are not accepted over HTTP (drop the file on the page)")
+    import brdfkit as bk
+
+    shown = name if len(name) <= 80 and name.isprintable() else repr(name[:80]) + "..."
+    raise ValueError(f"unknown model {shown!r}; valid models: {', '.join(bk.models())} or a built-in measured material")
+
+
+def web_model_class(name: str):
+    """The registry class a web request names; a file path or unknown name is a one-line ValueError."""
+    import brdfkit as bk
+    from .. import registry
+
+    if isinstance(name, str) and name in bk.models():
+        return registry.get(name)
+    _refuse(name)
+
+
+def web_model(name: str, params: dict | None = None):
+    """The model a web request names: a registry name or a built-in measured material, nothing else.
+
+    ``bk.model`` also takes file paths (``.brdf``, ``.binary``) for local use; a
+    request from the page must never make the server read a file of its choosing
+    (nor quote a line of one in an error), so paths are refused here, in one place.
+    """
+    import brdfkit as bk
+    from ..measured import nbrdf
+
+    if isinstance(name, str) and name in nbrdf.materials():
+        if params:
+            raise ValueError(f"{name}: a measured material takes no parameters")
+        return bk.material(name)
+    return web_model_class(name)(**(params or {}))
 
 
 def route(method: str, path: str):
@@ -413,7 +450,7 @@ def ibl_sampler(query: dict, body: bytes):
         raise ValueError("params: must be a JSON object")
     from ..measured import nbrdf
 
-    m = bk.material(name) if name in nbrdf.materials() else bk.model(name, **params)
+    m = web_model(name, params)
     return _json(_jsonable(ibl.sampler_uniforms(m)))
 
 
@@ -439,7 +476,7 @@ def derived_uniforms(query: dict, body: bytes):
         raise ValueError(f"params: not valid JSON ({e.msg})") from None
     if not isinstance(params, dict):
         raise ValueError("params: must be a JSON object")
-    values = glsl.uniform_values(bk.model(name, **params))
+    values = glsl.uniform_values(web_model(name, params))
     names = table.get(name, {})
     return _json({"uniforms": _jsonable({k: v for k, v in values.items() if k in names})})
 
@@ -464,7 +501,7 @@ def validate_payload(query: dict, body: bytes):
     if not isinstance(params, dict):
         return _json({"ok": False, "error": "params: must be a JSON object like {\"kd\": 0.5}"})
     try:
-        m = bk.model(name, **params)
+        m = web_model(name, params)
     except ValueError as e:
         return _json({"ok": False, "error": str(e).strip().splitlines()[0]})
     return _json({"ok": True, "params": _jsonable(to_jsonable(m.params))})
@@ -493,7 +530,7 @@ def albedo_payload(query: dict, body: bytes):
         raise ValueError(f"n must be an integer, got {text!r}") from None
     if not 2 <= n <= 200:
         raise ValueError(f"n {n} is out of range; allowed [2, 200]")
-    m = bk.material(name) if "/" in name else bk.model(name, **params)
+    m = web_model(name, params)
     theta = np.radians(np.linspace(0.0, 89.0, n))
     rho = np.asarray(albedo(m, theta, over="wo", level="fast", include_delta=False), dtype=np.float64)
     rho = np.where(np.isfinite(rho), rho, 0.0)

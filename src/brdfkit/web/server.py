@@ -110,13 +110,20 @@ def models_payload() -> dict[str, Any]:
     return {"models": out}
 
 
+def _web_model_class(name: str):
+    """A registry model class by name; never a file path (see :func:`brdfkit.web.api.web_model`)."""
+    from .api import web_model_class
+
+    return web_model_class(name)
+
+
 def shader_payload(name: str) -> str:
     """The body of ``GET /api/shader/<model>``: GLSL ES 3.00 source with its ``#version`` line."""
     from brdfkit import registry
     from brdfkit.render import glsl
 
     try:  # an unknown model, or one without a GLSL file
-        return "#version 300 es\n" + glsl.shader_source(registry.get(name))
+        return "#version 300 es\n" + glsl.shader_source(_web_model_class(name))
     except ValueError as e:
         raise BadRequest(str(e)) from None
 
@@ -180,7 +187,9 @@ def eval_payload(query: dict[str, list[str]]) -> dict[str, Any]:
     except ValueError:
         raise BadRequest(f"wi and wo do not broadcast: {len(wi)} and {len(wo)} directions") from None
     try:
-        m = bk.model(name, **params)
+        from .api import web_model
+
+        m = web_model(name, params)
         value = m.eval(wi_b, wo_b)
     except (ValueError, TypeError, OverflowError) as e:
         raise BadRequest(_one_line(e)) from None
