@@ -271,7 +271,6 @@ def test_uniforms_match_spec(name):
     cls = bk.registry.get(name)
     declared = glsl.declared_uniforms(glsl.shader_path(name).read_text())
     expected = glsl.declared_uniforms(glsl.uniform_declarations(name))
-    expected.update(glsl.DERIVED_UNIFORMS.get(name, {}))
     assert declared == expected
     assert set(glsl.uniform_values(cls())) == set(expected)
 

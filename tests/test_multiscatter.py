@@ -145,3 +145,13 @@ def test_glsl_twin_adds_the_same_lobe():
 def test_bad_input_is_a_value_error():
     with pytest.raises(ValueError, match="multiscatter"):
         bk.model("microfacet", multiscatter="maybe")
+
+
+def test_glsl_tables_are_the_shipped_tables():
+    """shaders/microfacet.glsl carries the tables as constants; they must be the current .npz (regenerate
+    with brdfkit.terms.multiscatter.write_glsl_tables())."""
+    from brdfkit.render import glsl
+
+    text = glsl.shader_path("microfacet").read_text(encoding="utf-8")
+    i, j = text.index(ms.GLSL_BEGIN), text.index(ms.GLSL_END)
+    assert text[i:text.index("\n", j) + 1] == ms.glsl_tables()

@@ -246,3 +246,17 @@ def test_ibl_shaders_are_glsl_es():
         f.write_text(src)
         r = subprocess.run([exe, str(f)], capture_output=True, text=True)
     assert r.returncode == 0, r.stdout + r.stderr
+
+
+def test_measured_material_under_an_environment():
+    """A measured near-mirror (chrome-steel) gets a narrow sampling lobe; its IBL render is finite,
+    non-negative and shows the soft boxes (it was black but for one highlight under a point light)."""
+    m = bk.material("merl/chrome-steel")
+    a, pd = ibl.measured_lobe(m)
+    assert a < 0.05 and 0.1 <= pd <= 0.9
+    env = E.environment_from_spec({"name": "studio", "visible": False})[0]
+    s = _scene(m, env, size=32, samples=16)
+    img = default_renderer().render_linear(s, "glsl")
+    assert np.all(np.isfinite(img)) and img.min() >= 0
+    mask, _ = _facing(s, 0.1)
+    assert np.percentile(img[mask][:, :3].max(-1), 99) > 0.5  # bright reflections of the boxes

@@ -9,10 +9,20 @@ Each figure is a grid of panels with a caption under every panel and a title:
                            seen at a grazing angle (Blinn's highlight stretches, Phong's stays round)
 ``lambert-vs-oren-nayar``  a matte sphere, lit from the viewer and from the side
 ``cook-torrance-metals``   Cook–Torrance 1982 metals (index of refraction from the normal-incidence
-                           reflectance, as the paper does) and a roughness sweep
+                           reflectance, as the paper does) and a roughness sweep, in the studio environment
 ``ward-anisotropic``       Ward's brushed (anisotropic) highlight against the isotropic one
 ``measured``               six measured MERL materials (built-in Neural-BRDF networks, tabulated
-                           to the MERL grid and looked up in a 3D texture by ``shaders/measured.glsl``)
+                           to the MERL grid and looked up in a 3D texture by ``shaders/measured.glsl``),
+                           in the studio environment
+``metals-ibl``             gold, copper, silver, aluminium (microfacet, complex index, multiple
+                           scattering) and four measured metals, in the studio environment
+``white-furnace``          microfacet spheres (F = 1) in a uniform white environment at increasing
+                           roughness, single scattering vs the Kulla-Conty compensation: a sphere that
+                           conserves energy disappears into the background
+
+The figures lit by an environment (``cook-torrance-metals``, ``measured``, ``metals-ibl``,
+``white-furnace``) use image-based lighting (:mod:`brdfkit.render.environment`,
+``shaders/ibl.glsl``) with ``IBL_SAMPLES`` samples per pixel.
 
 Nothing is downloaded: meshes are built in, materials are the registered models.
 """
@@ -164,12 +174,17 @@ def _cook_torrance_metals() -> list[Panel]:
 
     teapot = {"builtin": "teapot", "subdivisions": 10}
     out = []
+    # lit by the studio environment: under the former point lights the metals' colours were
+    # unreadable (copper pale pink-grey, silver = aluminium, 6 % of the pixels clipped); the
+    # exposure 0.6 makes up for the 1982 formula's 1/π, 4x the modern 1/4 (docs/physics.md)
     for name, f0 in METALS.items():
         m = bk.model("cook-torrance", kd=0.0, ks=1.0, m=0.2, ior=_ior_from_f0(f0))
-        out.append(Panel(f"{name}, m = 0.2", teapot, m, "phong", TEAPOT_CAM, STUDIO, STUDIO_AMBIENT, 0.6))
+        out.append(Panel(f"{name}, m = 0.2", teapot, m, "phong", TEAPOT_CAM, exposure=0.6, environment="studio",
+                         samples=IBL_SAMPLES))
     for rough in (0.08, 0.15, 0.3, 0.5):
         m = bk.model("cook-torrance", kd=0.0, ks=1.0, m=rough, ior=_ior_from_f0(METALS["gold"]))
-        out.append(Panel(f"gold, m = {rough:g}", teapot, m, "phong", TEAPOT_CAM, STUDIO, STUDIO_AMBIENT, 0.6))
+        out.append(Panel(f"gold, m = {rough:g}", teapot, m, "phong", TEAPOT_CAM, exposure=0.6, environment="studio",
+                         samples=IBL_SAMPLES))
     return out
 
 
@@ -209,7 +224,7 @@ def _metals_ibl() -> list[Panel]:
     for name, (eta, k) in CONDUCTORS.items():
         m = bk.model("microfacet", alpha=0.12, eta=eta, k=k, multiscatter=True)
         out.append(Panel(f"{name}, α = 0.12", teapot, m, "phong", TEAPOT_CAM, environment="studio", samples=IBL_SAMPLES))
-    for name in ("merl/chrome-steel", "merl/alum-bronze", "merl/gold-metallic-paint", "merl/blue-metallic-paint"):
+    for name in ("merl/chrome", "merl/brass", "merl/aluminium", "merl/nickel"):
         out.append(Panel(name.split("/", 1)[1] + " (measured)", teapot, bk.material(name), "phong", TEAPOT_CAM,
                          environment="studio", samples=IBL_SAMPLES))
     return out
@@ -248,12 +263,10 @@ def _measured() -> list[Panel]:
     import brdfkit as bk
 
     sphere = {"builtin": "sphere", "segments": 96, "rings": 48}
-    lights = [
-        Light(position=(-1.0, 1.2, 1.5, 0.0), diffuse=(1, 1, 1)),
-        Light(position=(1.5, -0.3, 1.0, 0.0), diffuse=(0.15, 0.15, 0.15)),
-    ]
-    lm = LightModel(ambient=(0.05, 0.05, 0.05))
-    return [Panel(name.split("/", 1)[1], sphere, bk.material(name), "phong", FRONT, lights, lm) for name in MEASURED]
+    # lit by the studio environment: under the former two point lights chrome-steel (a near
+    # mirror) was black but for one tiny highlight
+    return [Panel(name.split("/", 1)[1], sphere, bk.material(name), "phong", FRONT, environment="studio",
+                  samples=IBL_SAMPLES) for name in MEASURED]
 
 
 FIGURES: dict[str, Figure] = {
@@ -263,9 +276,9 @@ FIGURES: dict[str, Figure] = {
         Figure("gouraud-vs-phong", "Flat, Gouraud and Phong shading of chrome: the highlight inside a big triangle", 3, _gouraud_vs_phong),
         Figure("phong-vs-blinn-phong", "Phong (r·v)^s vs Blinn-Phong (n·h)^s: round vs stretched highlights", 3, _phong_vs_blinn),
         Figure("lambert-vs-oren-nayar", "Lambert vs Oren-Nayar on a matte sphere: rough surfaces look flat", 3, _lambert_vs_oren_nayar),
-        Figure("cook-torrance-metals", "Cook-Torrance (1982) metals, and gold from smooth to rough", 4, _cook_torrance_metals),
+        Figure("cook-torrance-metals", "Cook-Torrance (1982) metals, and gold from smooth to rough (studio environment)", 4, _cook_torrance_metals),
         Figure("ward-anisotropic", "Ward's anisotropic (brushed) highlight vs the isotropic one", 3, _ward),
-        Figure("measured", "Measured materials (MERL, as Neural-BRDF networks): the table as a 3D texture in GLSL", 6, _measured),
+        Figure("measured", "Measured materials (MERL, as Neural-BRDF networks) in the studio environment", 6, _measured),
         Figure("metals-ibl", "Metals (microfacet, complex index) and measured materials in the studio environment", 4, _metals_ibl),
         Figure("white-furnace", "White furnace (F = 1): single scattering loses energy, Kulla-Conty compensation restores it", 4, _white_furnace),
     )

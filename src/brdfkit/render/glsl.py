@@ -200,7 +200,7 @@ def declared_uniforms(source: str) -> dict[str, str]:
     text = re.sub(r"//[^\n]*", "", source)
     text = re.sub(r"/\*.*?\*/", "", text, flags=re.S)
     out = {}
-    for m in re.finditer(r"\buniform\s+(?:(?:lowp|mediump|highp)\s+)?(\w+)\s+(\w+)\s*(?:\[\s*\w+\s*\])?\s*;", text):
+    for m in re.finditer(r"\buniform\s+(?:(?:lowp|mediump|highp)\s+)?(\w+)\s+(\w+)\s*;", text):
         out[m.group(2)] = m.group(1)
     return out
 
@@ -238,15 +238,7 @@ def uniform_values(model: Any) -> dict[str, Any]:
             out[f"u_{p.name}"] = int(p.choices.index(v))
         else:  # int
             out[f"u_{p.name}"] = int(v)
-    if cls.name in DERIVED_UNIFORMS:  # uniforms computed from the parameters, not one per parameter
-        from ..terms import multiscatter
-
-        out.update(multiscatter.glsl_uniforms(model))
     return out
-
-
-DERIVED_UNIFORMS = {"microfacet": {"u_ms_missing": "float", "u_ms_scale": "vec3"}}
-"""Uniforms a model file declares beyond one per parameter: name -> GLSL type (arrays by element type)."""
 
 
 # ---------------------------------------------------------------------------

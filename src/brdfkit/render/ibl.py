@@ -7,7 +7,8 @@ per pixel,
 
 by Monte Carlo with multiple importance sampling (Veach & Guibas 1995, power heuristic)
 of the BRDF (the routine :func:`brdfkit.analysis.sampling.sampler_for` picks for the
-model, ported to GLSL; cosine-weighted for models without one) and of the environment
+model, ported to GLSL; cosine-weighted for models without one; for measured materials a
+cosine + GGX mixture sized by :func:`measured_lobe`) and of the environment
 (its luminance CDF, :meth:`Environment.sampling_tables`), accumulated over passes. The
 object does not shadow itself (no visibility test).
 
@@ -27,7 +28,6 @@ import numpy as np
 from ..geometry import normalize
 from .environment import Environment, direction_to_texel, row_solid_angles
 
-MEASURED_LOBE = (0.05, 0.05)  # GGX α of the half-vector lobe used for measured materials
 LOBES = {"none": 0, "phong": 1, "blinn": 2, "beckmann-h": 3, "ggx-h": 4, "ggx-visible": 5}
 
 
@@ -38,9 +38,10 @@ def sampler_uniforms(model: Any) -> dict[str, Any]:
     from .glsl import is_measured
 
     if is_measured(model):
-        # no sampler in analysis/sampling.py for tabulated data; measured materials are mostly
-        # glossy, so half the samples follow a narrow GGX lobe (any positive pdf is unbiased)
-        return {"bki_lobe": LOBES["ggx-h"], "bki_lobe_params": MEASURED_LOBE, "bki_diffuse_prob": 0.5}
+        # no sampler in analysis/sampling.py for tabulated data: a cosine + GGX mixture sized from
+        # the material's own peak (measured_lobe); any positive pdf keeps the estimate unbiased
+        a, pd = measured_lobe(model)
+        return {"bki_lobe": LOBES["ggx-h"], "bki_lobe_params": (a, a), "bki_diffuse_prob": pd}
     smp = s.sampler_for(model)
     comps, probs = ([smp], [1.0]) if not isinstance(smp, s.Mixture) else (list(smp.components), list(smp._p))
     pd = 0.0
@@ -62,6 +63,43 @@ def sampler_uniforms(model: Any) -> dict[str, Any]:
     if lobe == "none":
         pd = 1.0
     return {"bki_lobe": LOBES[lobe], "bki_lobe_params": params, "bki_diffuse_prob": min(max(pd, 0.0), 1.0)}
+
+
+_LOBE_CACHE: dict[str, tuple[float, float]] = {}
+
+
+def measured_lobe(model: Any) -> tuple[float, float]:
+    """A GGX α and a diffuse probability for sampling a measured material, from its values at
+    θo = 20°: the half-width θ½ of the peak around the mirror direction (above the diffuse
+    floor, the value 60° away) gives α = tan θ½ / √(√2 − 1) (where a GGX D falls to one half);
+    the diffuse probability is π f_floor over that plus the peak's albedo ≈ 4π α² cos² θo (f_peak − f_floor),
+    clipped to [0.1, 0.9]."""
+    from .glsl import table_key
+
+    key = table_key(model)
+    hit = _LOBE_CACHE.get(key)
+    if hit is not None:
+        return hit
+    to = math.radians(20.0)
+    wo = np.array([math.sin(to), 0.0, math.cos(to)])
+    # the half vector tilted from the normal by δ (in the plane ⟂ to the incidence plane): wi = reflect(wo, h)
+    deltas = np.radians(np.array([0.0, 0.25, 0.5, 1, 1.5, 2, 3, 4, 6, 8, 11, 15, 20, 27, 35]))
+    h = np.stack([np.zeros_like(deltas), np.sin(deltas), np.cos(deltas)], -1)
+    wi = 2 * (h @ wo)[:, None] * h - wo
+    ok = wi[:, 2] > 0.05
+    far = np.array([[-math.sin(math.radians(60)), 0.0, math.cos(math.radians(60))]])  # 40° from the mirror direction
+    f = np.asarray(model.eval(normalize(wi[ok]), np.broadcast_to(wo, (ok.sum(), 3))), dtype=np.float64) @ np.array([0.2126, 0.7152, 0.0722])
+    floor = float(np.asarray(model.eval(normalize(far), wo[None]), dtype=np.float64)[0] @ np.array([0.2126, 0.7152, 0.0722]))
+    peak = f - min(floor, f.min())
+    d = deltas[ok]
+    below = np.flatnonzero(peak < 0.5 * peak[0])
+    half = d[below[0]] if below.size else d[-1]
+    alpha = float(np.clip(math.tan(half) / math.sqrt(math.sqrt(2) - 1), 0.005, 1.0))
+    spec = 4 * math.pi * alpha**2 * math.cos(to) ** 2 * max(float(peak[0]), 0.0)
+    diff = math.pi * max(floor, 0.0)
+    pd = float(np.clip(diff / max(diff + spec, 1e-12), 0.1, 0.9))
+    _LOBE_CACHE[key] = (alpha, pd)
+    return alpha, pd
 
 
 def rotation_part(m3: np.ndarray) -> np.ndarray:

@@ -31,6 +31,15 @@ Backends
            GLSL file.
 ``auto``   ``glsl`` when the material has GLSL, else ``numpy``.
 
+Image-based lighting
+--------------------
+A scene with an ``environment`` (:mod:`brdfkit.render.environment`) is lit by it
+instead of the lights: ``shaders/ibl.glsl`` estimates the reflected radiance per
+fragment with multiple importance sampling of the BRDF and of the map, in passes of
+``IBL_SPP_PER_PASS`` samples accumulated up to ``scene.samples``; pixels the mesh
+does not cover show the map (``visible``). Its ``numpy`` backend is the brute-force
+integral of :func:`brdfkit.render.ibl.reference_shade` over every texel.
+
 Measured materials (a MERL table, a built-in Neural-BRDF material) have GLSL
 too: ``shaders/measured.glsl`` looks the MERL table up in a 3D texture
 (uploaded once per material and kept in a small cache; a Neural-BRDF material
