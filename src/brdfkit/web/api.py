@@ -68,6 +68,7 @@ ROUTES: dict[tuple[str, str], Handler] = {}
 JSON = "application/json; charset=utf-8"
 TEXT = "text/plain; charset=utf-8"
 MAX_UPLOAD = 64 * 1024 * 1024  # a MERL file is 33 MB
+NBRDF_FLOATS = 6 * 21 + 21 + 21 * 21 + 21 + 21 * 3 + 3  # 675
 
 
 def _refuse(name) -> None:
