@@ -49,10 +49,13 @@ Verification (formula audit; the paper's own text was not available to us):
   the tangent +x (so p → 0 gives scratches along +x), as LuxCore does for a
   positive anisotropy; RISE measures it from its second tangent. The paper's
   choice of reference axis could not be checked; it only swaps x and y.
-* NOT verified: the a/b/c split (b = 4r(1 − r), a or c = 1 − b). None of the
-  sources available to us states it; it is as the previous author recalled
-  it from the paper, and the auditor recalls the same form, but no document
-  confirms it.
+* the a/b/c split (b = 4r(1 − r), a = 0, c = 1 − b for r < 0.5 and a = 1 − b,
+  c = 0 otherwise): LuxCoreRender does not state it (its Schlick material has
+  the Z, A, G factors only), but it has an independent source: the renderer
+  OpalFalcon, named by the comparison with independent implementations
+  (issue 14) as stating this split. It is also what the previous author and
+  the auditor both recalled from the paper; not checked against the paper's
+  own text.
 
 Material types:
 
@@ -69,17 +72,18 @@ What ``eval`` returns and what it does not:
   :meth:`Schlick.mirror_reflectance` gives the delta's weight (the fraction of
   light from wi sent into reflect(wi)): c·S(cos θi), plus (1 − S)·S'·c' for
   the double slab.
-* The paper also has a term that re-injects the energy lost to
-  self-shadowing, weighted by 1 − G(v)G(v'). Its exact form stays
-  unresolved, so it is **not** implemented. The sources disagree: the
-  third-party digest writes D = G G' Z A/(4π v v') + (1 − G G')/(4π v v'),
-  whose second term alone has the albedo (1/(4π v))∫(1 − G(v)G(v'))dω',
-  which grows like 1/(2v) at grazing incidence (hardly what a paper that
-  claims energy conservation would propose, so possibly a transcription
-  slip); LuxCoreRender's optional "multibounce" term, which its source
-  calls an "alternative", is clamp((1 − G G')/(4 v v'), 0, 1), without π;
-  and the auditor recalls (1 − G G')/π, a Lambertian lobe, without a
-  document to confirm it.
+* ``reinjection`` (default false) adds the paper's re-injection of the
+  energy lost to self-shadowing, as best reconstructed: the glossy part
+  becomes ``b·[G(v)G(v')·Z(t)·A(w) + 1 − G(v)G(v')]/(4π v v')``, the form
+  the third-party digest writes (the weight b of the glossy part applies to
+  both terms). The sources disagree on this term — LuxCoreRender's optional
+  "multibounce" alternative is clamp((1 − G G')/(4 v v'), 0, 1) without π;
+  the auditor recalls a Lambertian (1 − G G')/π — and the paper's text was
+  not available to settle it. **Its albedo exceeds 1 at grazing incidence**:
+  the extra term alone grows like 1/(2v). Measured (color = 1, p = 1, mirror
+  part included, ``brdfkit.analysis.albedo``): r = 0.05: 1.00 at θ = 0°..60°,
+  1.14 at 80°, 1.47 at 85°, 5.3 at 89°; r = 0.5: 0.64 at 0°, 1.03 at 60°,
+  2.8 at 80°, 28.5 at 89°. Still reciprocal (symmetric in v, v').
 
 Properties: every factor is symmetric in wi and wo (u, t, w, and the product
 G(v)G(v')), so the model is reciprocal. Energy: Z/π is a normalised
@@ -91,11 +95,21 @@ r ∈ {0.05, 0.3, 0.5, 0.8} and p ∈ {1, 0.3}, but 1.014 at θi = 85° and 1.12
 at 89° for r = 0.05 — not strictly energy conserving at grazing incidence.
 r = 1 with color = 1 is exactly Lambert (albedo 1).
 
-Numerics: the glossy term is evaluated as
-Z A / (4π (r + (1−r) v)(r + (1−r) v')) (G(v)/v simplified), and Z's
-denominator as (hx² + hy²) + r t² (no cancellation for t → 1 and small r),
-so it is finite and accurate for every direction: no floors are needed.
-At h = n the azimuth w is undefined and A is taken as 1.
+Numerics (guarded for every parameter down to the smallest positive float
+and at the exact range edges, float32 and float64): with ``d = r + (1 − r)v``
+(= v/G(v)) and ``q = r/(s2 + r t²)`` (Z's denominator with 1 − t² = s2 =
+hx² + hy², so no cancellation for t → 1), the glossy part is evaluated as
+``(1 − r)/π · A · (q/d)(q/d')`` — the same as b·Z·A·G G'/(4π v v') since
+b·Z = 4(1 − r) q² — so neither Z = 1/r (at h = n) nor r² is ever formed; q ≤ 2
+everywhere. (Before this guard r = 1e-170 gave Inf, and float32 failed from
+r ≈ 1e-19.) A is evaluated as ``hypot(hx, hy)/hypot(√p·hy, hx/√p)``, which
+never squares p (1/sqrt(p) at w = 0 for tiny p instead of p/0); at h = n w is
+undefined and A is taken as 1. d and d' are floored at 1e-150 (1e-18 in
+float32), which only matters when r and v are both below that, and each
+slab's directional factor is capped at a quarter of the largest finite float
+of the dtype: a near-mirror slab (r → 0) lit and seen at grazing incidence
+has a true value beyond any float, and the cap keeps it finite (never NaN:
+no factor is 0 where another is infinite).
 
 A(w) is largest for w = 0, i.e. for half vectors tilted toward ±y: with
 p < 1 the facets are scratches along the tangent +x and the highlight is
@@ -111,6 +125,7 @@ p          scalar  1        (0, 1]           isotropy (1 isotropic, → 0 scratc
 color2     rgb     0.5      [0, 1]           C' of the lower slab (double only)
 r2         scalar  1        (0, 1]           roughness of the lower slab (double only)
 p2         scalar  1        (0, 1]           isotropy of the lower slab (double only)
+reinjection bool   false    true | false     add b·(1 − G G')/(4π v v'), the re-injected light
 =========  ======  =======  ===============  ==================================================
 """
 
@@ -134,31 +149,78 @@ def split_weights(r: float) -> tuple[float, float, float]:
 
 
 def _half_terms(wi, wo):
-    """``(t, s2, u, w2, at_n)``: n·h, 1 − (n·h)² (from hx² + hy², no cancellation), h·wi,
-    w² = cos² of h's azimuth from +x, and ``h == n``."""
+    """``(t, s2, u, hx, hy)``: n·h, 1 − (n·h)² (from hx² + hy², no cancellation), h·wi and h's
+    tangent-plane components."""
     h = half_vector(wi, wo)
     t = h[..., 2]
     u = np.clip(np.einsum("...i,...i->...", wi, h), 0, 1)
     s2 = h[..., 0] ** 2 + h[..., 1] ** 2
-    at_n = s2 == 0
-    w2 = np.where(at_n, 1, h[..., 0] ** 2 / np.where(at_n, 1, s2))
-    return np.clip(t, 0, 1), s2, u, w2, at_n
+    return np.clip(t, 0, 1), s2, u, h[..., 0], h[..., 1]
 
 
-def _slab_directional(t, s2, w2, at_n, v, v2, r, p, dt):
-    """One slab's directional factor without the mirror part: a/π + b·G G' Z A/(4π v v')."""
+def zenith_ratio(t, s2, r):
+    """``q = r/((1 − t²) + r t²)``, so that ``b·Z(t) = 4(1 − r)·q²`` (Z = r/(1 + r t² − t²)²).
+
+    Written with ``1 − t² = s2 = hx² + hy²``. q ≤ 2 for every h (s2 + t² = 1), and the
+    denominator never vanishes (s2 = 0 means t = 1), so neither r² nor Z itself is formed:
+    Z = 1/r at h = n overflows for r < 1e-308 and r² underflows for r < 1e-154 (Inf, NaN
+    before this guard).
+    """
+    return r / (s2 + r * t * t)
+
+
+def azimuth_factor(hx, hy, p):
+    """Schlick's A(w) = sqrt(p/(p² − p² w² + w²)), w = hx/sqrt(hx² + hy²), 1 at h = n.
+
+    Evaluated as ``hypot(hx, hy)/hypot(sqrt(p)·hy, hx/sqrt(p))`` (the same expression, since
+    p²(1 − w²) + w² = ((p hy)² + hx²)/(hx² + hy²)): p is never squared nor multiplied into a
+    subnormal, so p down to the smallest positive float gives the finite 1/sqrt(p) at w = 0
+    instead of p/0, to full precision.
+    """
+    sp = np.sqrt(p)
+    num = np.hypot(hx, hy)
+    den = np.hypot(sp * hy, hx / sp)
+    at_n = den == 0  # only at hx = hy = 0 (h = n): A is undefined there, take 1
+    return np.where(at_n, 1, num / np.where(at_n, 1, den))
+
+
+def masking_denominator(v, r, floor):
+    """``r + (1 − r) v = v/G(v)`` (G(v) = v/(r − r v + v)), floored at ``floor`` > 0."""
+    return np.maximum(r + (1 - r) * v, floor)
+
+
+def reinjection(v, v2, r, pi):
+    """The re-injected light ``b·(1 − G(v)G(v'))/(4π v v')`` (b = 4r(1 − r)), without cancellation.
+
+    ``1 − G G' = r·B/(d d')`` with ``d = r + (1 − r) v`` and
+    ``B = r + (1 − r)(v + v') − (2 − r) v v'`` (≥ 0, 0 at v = v' = 1), so the term is
+    ``(1 − r)/π · (r/(d v)) · (r/(d' v')) · B``. Each ``r/(d v)`` lies in [r, ∞] (d, v ≤ 1),
+    so their product is never 0·∞ and b/(4π) is never formed (it underflows for tiny r).
+    """
+    B = np.maximum(r + (1 - r) * (v + v2) - (2 - r) * v * v2, 0)
+    x1 = r / (r + (1 - r) * v) / v
+    x2 = r / (r + (1 - r) * v2) / v2
+    return (1 - r) / pi * (x1 * x2) * B
+
+
+def _slab_directional(t, s2, hx, hy, v, v2, r, p, dt, reinject=False):
+    """One slab's directional factor without the mirror part: a/π + b·G G' Z A/(4π v v')
+    [+ b·(1 − G G')/(4π v v') with ``reinjection``], capped at a quarter of the dtype's largest value."""
     a, b, _ = split_weights(float(r))
     pi = dt(np.pi)
-    # 1 + r t² − t² = (1 − t²) + r t², with 1 − t² = hx² + hy² (accurate for t → 1, small r)
-    Z = r / (s2 + r * t * t) ** 2
-    if p == 1:
-        A = np.ones_like(t)
-    else:
-        # w is undefined at h = n: take the isotropic value 1 there
-        A = np.where(at_n, dt(1), np.sqrt(p / (p * p - p * p * w2 + w2)))
-    # G(v)G(v')/(v v') = 1/((r + (1-r) v)(r + (1-r) v'))
-    gg = dt(1) / ((r + (dt(1) - r) * v) * (r + (dt(1) - r) * v2))
-    return dt(a) / pi + dt(b) * Z * A * gg / (dt(4) * pi)
+    info = np.finfo(dt)
+    # floors that keep each factor finite: b·Z·A·G G'/(v v') = 4(1 − r) q² A/(d d'), q ≤ 2;
+    # d = r + (1 − r) v only drops below them for r and v both below ~1e-150 (1e-18 in float32)
+    floor = dt(1e-150) if dt == np.float64 else dt(1e-18)
+    q = zenith_ratio(t, s2, r)
+    A = np.ones_like(t) if p == 1 else azimuth_factor(hx, hy, p)
+    d1 = masking_denominator(v, r, floor)
+    d2 = masking_denominator(v2, r, floor)
+    # b Z A G G'/(4π v v') = (1 − r)/π · A · (q/d)(q/d')
+    gloss = (dt(1) - r) / pi * A * (q / d1) * (q / d2) if b > 0 else np.zeros_like(t)
+    if reinject and b > 0:
+        gloss = gloss + reinjection(v, v2, r, pi)
+    return np.minimum(dt(a) / pi + gloss, info.max / dt(4))
 
 
 @register
@@ -190,18 +252,27 @@ class Schlick(BRDF):
         Param("color2", "rgb", 0.5, (0.0, 1.0), "", "C' of the lower slab (layers=double only)"),
         Param("r2", "scalar", 1.0, (0.0, 1.0), "", "roughness of the lower slab (layers=double only)", open_lo=True),
         Param("p2", "scalar", 1.0, (0.0, 1.0), "", "isotropy of the lower slab (layers=double only)", open_lo=True),
+        Param(
+            "reinjection",
+            "bool",
+            False,
+            doc="add the paper's re-injection of the light lost to self-shadowing, b·(1 − G G')/(4π v v') "
+            "(as reconstructed; its albedo exceeds 1 at grazing incidence)",
+            fit=False,
+        ),
     )
 
     def _eval(self, wi, wo, p):
         dt = wi.dtype.type
-        t, s2, u, w2, at_n = _half_terms(wi, wo)
+        t, s2, u, hx, hy = _half_terms(wi, wo)
         v, v2 = wi[..., 2], wo[..., 2]
+        rein = bool(p["reinjection"])
         S = fresnel_schlick(p["color"], u[..., None])
-        D = _slab_directional(t, s2, w2, at_n, v, v2, p["r"], p["p"], dt)[..., None]
+        D = _slab_directional(t, s2, hx, hy, v, v2, p["r"], p["p"], dt, rein)[..., None]
         f = S * D
         if p["layers"] == "double":
             S2 = fresnel_schlick(p["color2"], u[..., None])
-            D2 = _slab_directional(t, s2, w2, at_n, v, v2, p["r2"], p["p2"], dt)[..., None]
+            D2 = _slab_directional(t, s2, hx, hy, v, v2, p["r2"], p["p2"], dt, rein)[..., None]
             f = f + (dt(1) - S) * S2 * D2
         return f
 
