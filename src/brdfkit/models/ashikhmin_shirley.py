@@ -49,13 +49,29 @@ Numerics: h·k and max(n·wi, n·wo) are clamped to a floor of 1e-6 in the
 denominator (they vanish only when both directions are within 0.00006° of
 the horizon), which keeps every value finite.
 
+Variant ``"ngan"`` (Ngan, Durand & Matusik, "Experimental Analysis of BRDF
+Models", EGSR 2005, the form their fits to the MERL data use): the diffuse term
+is decoupled — a plain Lambert ``kd/π`` — and the specular lobe gets its own RGB
+weight ``ks`` and its own Schlick Fresnel reflectance ``f0``::
+
+    f_r = kd/π + ks · sqrt((nu+1)(nv+1))/(8π) · (n·h)^(nu cos²φh + nv sin²φh)
+                     / ((h·k) · max(n·wi, n·wo)) · F(h·k),   F(c) = f0 + (1 − f0)(1 − c)⁵
+
+(``rd`` and ``rs`` are not used there; ``kd``, ``ks`` and ``f0`` are not used by
+``"paper"``). Both variants share the lobe function below; ``"paper"`` is
+``"ngan"`` with ks = 1, f0 = R_s and the coupled ρ_d in place of kd/π.
+
 =========  ======  =======  ============  =============================================
 parameter  kind    default  range         meaning
 =========  ======  =======  ============  =============================================
-rd         rgb     0.5      [0, 1]        diffuse reflectance R_d
-rs         rgb     0.05     [0, 1]        specular reflectance at normal incidence R_s
+variant    choice  paper    paper | ngan  the paper's coupled form, or Ngan et al.'s
+rd         rgb     0.5      [0, 1]        diffuse reflectance R_d (paper)
+rs         rgb     0.05     [0, 1]        specular reflectance at normal incidence R_s (paper)
 nu         scalar  100      [0, 1e5]      Phong exponent along the tangent +x
 nv         scalar  100      [0, 1e5]      Phong exponent along the bitangent +y
+kd         rgb     0.5      [0, 1]        Lambert diffuse albedo (ngan)
+ks         rgb     1        [0, 10]       weight of the specular lobe (ngan)
+f0         rgb     0.05     [0, 1]        Schlick reflectance at normal incidence (ngan)
 =========  ======  =======  ============  =============================================
 """
 
@@ -92,17 +108,36 @@ class AshikhminShirley(BRDF):
     reference = "Ashikhmin and Shirley, An Anisotropic Phong BRDF Model, JGT 5(2), 2000"
     isotropic = False
     spec = (
+        Param(
+            "variant",
+            "choice",
+            "paper",
+            doc="paper: coupled R_d/R_s (Ashikhmin & Shirley 2000); ngan: Lambert kd + ks·lobe with "
+            "Schlick f0 (Ngan, Durand & Matusik 2005)",
+            choices=("paper", "ngan"),
+            fit=False,
+        ),
         Param("rd", "rgb", 0.5, (0.0, 1.0), "", "diffuse reflectance R_d"),
         Param("rs", "rgb", 0.05, (0.0, 1.0), "", "specular reflectance at normal incidence R_s (Schlick F0)"),
         exponent_param("nu", 100.0, "Phong exponent along the tangent +x (smaller = wider highlight in x)"),
         exponent_param("nv", 100.0, "Phong exponent along the bitangent +y"),
+        Param("kd", "rgb", 0.5, (0.0, 1.0), "", "Lambert diffuse albedo kd (variant=ngan only)"),
+        Param("ks", "rgb", 1.0, (0.0, 10.0), "", "weight of the specular lobe (variant=ngan only)",
+              fit_range=(0.0, 5.0)),
+        Param("f0", "rgb", 0.05, (0.0, 1.0), "", "Schlick reflectance at normal incidence (variant=ngan only)"),
     )
+
+    def active_params(self) -> dict:
+        """``params`` less the other variant's parameters."""
+        unused = ("kd", "ks", "f0") if self.params["variant"] == "paper" else ("rd", "rs")
+        return {k: v for k, v in self.params.items() if k not in unused}
 
     def _eval(self, wi, wo, p):
         dt = wi.dtype.type
         pi = dt(np.pi)
-        rd, rs = p["rd"], p["rs"]
         nu, nv = p["nu"], p["nv"]
+        ngan = p["variant"] == "ngan"
+        f0 = p["f0"] if ngan else p["rs"]
         h = half_vector(wi, wo)
         hx, hy, hz = h[..., 0], h[..., 1], h[..., 2]
         hk = np.clip(np.einsum("...i,...i->...", wi, np.stack([hx, hy, hz], axis=-1)), dt(0), dt(1))
@@ -111,7 +146,10 @@ class AshikhminShirley(BRDF):
         floor = dt(COS_FLOOR)
         denom = np.maximum(hk, floor) * np.maximum(np.maximum(ci, co), floor)
         k = np.sqrt((nu + dt(1)) * (nv + dt(1))) / (dt(8) * pi)
-        spec = (k * lobe / denom)[..., None] * fresnel_schlick(rs, hk[..., None])
+        spec = (k * lobe / denom)[..., None] * fresnel_schlick(f0, hk[..., None])
+        if ngan:
+            return p["kd"] / pi + p["ks"] * spec
+        rd, rs = p["rd"], p["rs"]
         a = dt(1) - (dt(1) - ci * dt(0.5)) ** 5
         b = dt(1) - (dt(1) - co * dt(0.5)) ** 5
         diff = (dt(28) / (dt(23) * pi)) * rd * (dt(1) - rs) * (a * b)[..., None]
