@@ -127,13 +127,23 @@ Parameters
 ==============  ======  ====================  ===============  =============================================
 parameter       kind    default               range            meaning
 ==============  ======  ====================  ===============  =============================================
-sigma0          scalar  0.18                  [0, 2] µm        RMS surface height σ0 (0: a perfect mirror)
-tau             scalar  3.0                   [0.05, 100] µm   autocorrelation length τ
+sigma0          scalar  0.18                  [0, 2] µm        RMS surface height σ0 (0: a perfect mirror);
+                                                               fitted in [0.005, 1.5] µm
+tau             scalar  3.0                   [0.05, 100] µm   autocorrelation length τ; fitted in [0.3, 30] µm
+                                                               (log scale), so slopes 2σ0/τ up to 10
 eta             rgb     1.49, 0.96, 0.62      [0.01, 10]       refractive index n per channel
 k               rgb     7.82, 6.69, 5.46      [0, 20]          extinction coefficient per channel (0: dielectric)
 wavelengths     rgb     650, 550, 450         [200, 2000] nm   wavelength each RGB channel is evaluated at
 kd              rgb     0                     [0, 1]           uniform-diffuse albedo (kd/π)
+ks              rgb     1                     [0, 10]          scale of the surface reflection (directional
+                                                               diffuse and specular); 1 is the physical model
 ==============  ======  ====================  ===============  =============================================
+
+``ks`` is not part of the 1991 model (which is ks = 1): measured materials
+(paints, plastics) reflect less or more at their surface than the Fresnel factor
+of one set of optical constants predicts, and a fitter needs that freedom, as
+Ngan et al. (2005) give every lobe model an RGB weight. It multiplies ρ_dd and
+the coherent specular part alike, so the two stay in the ratio the physics sets.
 
 The defaults are the paper's aluminium example (σ0 = 0.18 µm, τ = 3 µm) with
 approximate optical constants of aluminium at the three wavelengths (after Rakić 1995).
@@ -446,14 +456,16 @@ class HTSG(BRDF):
     isotropic = True
     spec = (
         Param("sigma0", "scalar", 0.18, (0.0, 2.0), "µm", "RMS surface height σ0 (0 is a perfect mirror)",
-              fit_range=(0.0, 1.0)),
+              fit_range=(0.005, 1.5)),
         Param("tau", "scalar", 3.0, (0.05, 100.0), "µm", "autocorrelation length τ of the surface heights",
-              log_scale=True),
+              fit_range=(0.3, 30.0), log_scale=True),
         Param("eta", "rgb", _AL_ETA, (0.01, 10.0), "", "refractive index n per channel (default: aluminium)"),
         Param("k", "rgb", _AL_K, (0.0, 20.0), "", "extinction coefficient per channel (0 for a dielectric)"),
         Param("wavelengths", "rgb", (650.0, 550.0, 450.0), (200.0, 2000.0), "nm",
               "wavelength at which each RGB channel is evaluated", fit=False),
         Param("kd", "rgb", 0.0, (0.0, 1.0), "", "uniform-diffuse albedo (the term kd/π)"),
+        Param("ks", "rgb", 1.0, (0.0, 10.0), "", "scale of the surface reflection (directional diffuse and "
+              "specular; 1 = the 1991 model)", fit_range=(0.0, 3.0)),
     )
 
     def _setup(self) -> None:
@@ -464,6 +476,7 @@ class HTSG(BRDF):
         self._eta = np.asarray(p["eta"], dtype=np.float64)
         self._k = np.asarray(p["k"], dtype=np.float64)
         self._kd = np.asarray(p["kd"], dtype=np.float64)
+        self._ks = np.asarray(p["ks"], dtype=np.float64)
 
     # -- parts -------------------------------------------------------------
     def directional_diffuse(self, wi, wo) -> np.ndarray:
@@ -495,14 +508,14 @@ class HTSG(BRDF):
         geo = (v2 * v2 * Si * So / np.pi)[..., None]
         cos_local = np.clip(0.5 * np.sqrt(v2), 0.0, 1.0)
         F = fresnel_conductor(cos_local[..., None], self._eta, self._k)
-        return F * geo * k2 * (np.pi * self._tau / (2.0 * lam)) ** 2 * ratio
+        return self._ks * F * geo * k2 * (np.pi * self._tau / (2.0 * lam)) ** 2 * ratio
 
     def delta_reflectance(self, w) -> np.ndarray:
         """The coherent mirror part (see :meth:`specular_reflectance`), for albedo and energy checks."""
         return self.specular_reflectance(w)
 
     def specular_reflectance(self, wi) -> np.ndarray:
-        """Fraction of the incident power in the coherent mirror reflection: ``|F(θi)|² e^(−g) S(θi)²``.
+        """Fraction of the incident power in the coherent mirror reflection: ``ks·|F(θi)|² e^(−g) S(θi)²``.
 
         ``wi`` (..., 3) toward the light; returns (..., 3) RGB (0 where ``wi.z <= 0``); float32 in
         gives float32 out. The reflected direction is :meth:`specular_direction`.
@@ -522,8 +535,8 @@ class HTSG(BRDF):
             g = (2.0 * np.pi * sigma[..., None] / self._lam) ** 2 * (2.0 * c[..., None]) ** 2
             S = shadowing(c, self._sigma0, self._tau) ** 2
             out = F * np.exp(-g) * S[..., None]
-        out = np.where(valid[..., None], out, 0.0)
-        return np.clip(out, 0.0, 1.0).astype(dtype)
+        out = np.where(valid[..., None], self._ks * out, 0.0)
+        return np.clip(out, 0.0, None).astype(dtype)
 
     @staticmethod
     def specular_direction(wi) -> np.ndarray:
