@@ -14,9 +14,43 @@ Rusinkiewicz (1998) half/difference angles: with ``h = normalize(wi + wo)``,
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
+from .engine import jit
+
 _TINY = 1e-300
+
+
+# ------------------------------------------------ scalar forms for the kernels
+
+
+@jit
+def dot3(ax, ay, az, bx, by, bz):
+    """``a·b`` of two vectors given by components."""
+    return ax * bx + ay * by + az * bz
+
+
+@jit
+def half_vector_c(ix, iy, iz, ox, oy, oz):
+    """``normalize(wi + wo)`` in component form, robust at grazing angles: the scalar twin of :func:`half_vector`.
+
+    The sum is first divided by its largest absolute component (see
+    :func:`scaled_sum`), so the normalisation neither underflows nor
+    overflows; ``+z`` where ``wi == −wo``.
+    """
+    sx = ix + ox
+    sy = iy + oy
+    sz = iz + oz
+    m = max(abs(sx), max(abs(sy), abs(sz)))
+    if m == 0.0:
+        return 0.0, 0.0, 1.0
+    sx /= m
+    sy /= m
+    sz /= m
+    n = math.sqrt(sx * sx + sy * sy + sz * sz)
+    return sx / n, sy / n, sz / n
 
 
 def dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
