@@ -93,6 +93,16 @@ def _from_env() -> str:
 
 _current = _from_env()
 
+# numba's parallel loops run on its "workqueue" threading layer, which survives fork()
+# (process pools: `check --all --jobs`, batch fitting); GNU OpenMP, numba's default
+# here, aborts a forked child. workqueue is not reentrant, so the driver serialises
+# calls from several Python threads with a lock (each call uses every core anyway).
+# An explicit NUMBA_THREADING_LAYER wins.
+if "NUMBA_THREADING_LAYER" not in os.environ:
+    import numba as _numba
+
+    _numba.config.THREADING_LAYER = "workqueue"
+
 
 def set_engine(name: str) -> None:
     """Select the evaluation engine: ``"compiled"`` (default) or ``"reference"``."""

@@ -96,6 +96,8 @@ def drive(wi, wo, p, c, out, lim, nrm):
 
 _DRIVERS: dict[tuple[str, str], Callable] = {}
 _LOCK = threading.Lock()
+#: one parallel launch at a time (numba's workqueue layer is not reentrant across threads)
+_RUN_LOCK = threading.Lock()
 
 
 def nchunks(n: int) -> int:
@@ -142,7 +144,12 @@ def run(kernel: Callable, wi: np.ndarray, wo: np.ndarray, p: np.ndarray, c: np.n
         nrm[:] = [1.0, 1.0, 0.0, 1.0, 1.0, 0.0]
         return nrm
     lim = float(np.finfo(out.dtype).max)
-    driver_for(kernel)(wi, wo, p, c, out, lim, nrm)
+    drive = driver_for(kernel)
+    if n <= CHUNK:  # a single chunk runs inline, no thread pool: no lock needed
+        drive(wi, wo, p, c, out, lim, nrm)
+    else:
+        with _RUN_LOCK:
+            drive(wi, wo, p, c, out, lim, nrm)
     return nrm
 
 
