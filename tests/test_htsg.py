@@ -297,8 +297,8 @@ def test_off_specular_peaks():
 
 def test_contract_dtype_zero_below_and_parts():
     m = bk.model("htsg", kd=0.2)
-    wi = np.array([[0.3, 0.1, 0.9], [0.3, 0.1, -0.2]], dtype=np.float32)
-    wo = np.array([[-0.5, 0.0, 0.8], [0.0, 0.0, 1.0]], dtype=np.float32)
+    wi = bk.geometry.normalize(np.array([[0.3, 0.1, 0.9], [0.3, 0.1, -0.2]])).astype(np.float32)
+    wo = bk.geometry.normalize(np.array([[-0.5, 0.0, 0.8], [0.0, 0.0, 1.0]])).astype(np.float32)
     f = m.eval(wi, wo)
     assert f.dtype == np.float32 and f.shape == (2, 3)
     assert np.all(f[1] == 0) and np.all(f[0] > 0.2 / np.pi)

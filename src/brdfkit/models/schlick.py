@@ -131,16 +131,26 @@ reinjection bool   false    true | false     add b·(1 − G G')/(4π v v'), the
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
-from ..geometry import half_vector
+from ..engine import jit
+from ..geometry import dot3, half_vector_c
 from ..params import Param
 from ..registry import register
-from ..terms.fresnel import fresnel_schlick
+from ..terms.fresnel import f_schlick, fresnel_schlick
 from .base import BRDF
 
+#: cap on one slab's directional factor: a near-mirror slab (r → 0) at grazing incidence has a
+#: true value beyond any float; capped, S·D and the double slab's sum stay finite (never 0·∞)
+SLAB_CAP = 1e300
+#: floor on d = r + (1 − r) v: only reached when r and v are both below it
+D_FLOOR = 1e-300
 
-def split_weights(r: float) -> tuple[float, float, float]:
+
+@jit
+def split_weights(r):
     """Schlick's Lambertian / glossy / mirror fractions ``(a, b, c)`` for roughness ``r``."""
     b = 4.0 * r * (1.0 - r)
     if r < 0.5:
@@ -148,16 +158,7 @@ def split_weights(r: float) -> tuple[float, float, float]:
     return 1.0 - b, b, 0.0
 
 
-def _half_terms(wi, wo):
-    """``(t, s2, u, hx, hy)``: n·h, 1 − (n·h)² (from hx² + hy², no cancellation), h·wi and h's
-    tangent-plane components."""
-    h = half_vector(wi, wo)
-    t = h[..., 2]
-    u = np.clip(np.einsum("...i,...i->...", wi, h), 0, 1)
-    s2 = h[..., 0] ** 2 + h[..., 1] ** 2
-    return np.clip(t, 0, 1), s2, u, h[..., 0], h[..., 1]
-
-
+@jit
 def zenith_ratio(t, s2, r):
     """``q = r/((1 − t²) + r t²)``, so that ``b·Z(t) = 4(1 − r)·q²`` (Z = r/(1 + r t² − t²)²).
 
@@ -169,6 +170,7 @@ def zenith_ratio(t, s2, r):
     return r / (s2 + r * t * t)
 
 
+@jit
 def azimuth_factor(hx, hy, p):
     """Schlick's A(w) = sqrt(p/(p² − p² w² + w²)), w = hx/sqrt(hx² + hy²), 1 at h = n.
 
@@ -177,19 +179,17 @@ def azimuth_factor(hx, hy, p):
     subnormal, so p down to the smallest positive float gives the finite 1/sqrt(p) at w = 0
     instead of p/0, to full precision.
     """
-    sp = np.sqrt(p)
-    num = np.hypot(hx, hy)
-    den = np.hypot(sp * hy, hx / sp)
-    at_n = den == 0  # only at hx = hy = 0 (h = n): A is undefined there, take 1
-    return np.where(at_n, 1, num / np.where(at_n, 1, den))
+    if p == 1.0:
+        return 1.0
+    sp = math.sqrt(p)
+    den = math.hypot(sp * hy, hx / sp)
+    if den == 0.0:  # only at hx = hy = 0 (h = n): A is undefined there, take 1
+        return 1.0
+    return math.hypot(hx, hy) / den
 
 
-def masking_denominator(v, r, floor):
-    """``r + (1 − r) v = v/G(v)`` (G(v) = v/(r − r v + v)), floored at ``floor`` > 0."""
-    return np.maximum(r + (1 - r) * v, floor)
-
-
-def reinjection(v, v2, r, pi):
+@jit
+def reinjection(v, v2, r):
     """The re-injected light ``b·(1 − G(v)G(v'))/(4π v v')`` (b = 4r(1 − r)), without cancellation.
 
     ``1 − G G' = r·B/(d d')`` with ``d = r + (1 − r) v`` and
@@ -197,30 +197,56 @@ def reinjection(v, v2, r, pi):
     ``(1 − r)/π · (r/(d v)) · (r/(d' v')) · B``. Each ``r/(d v)`` lies in [r, ∞] (d, v ≤ 1),
     so their product is never 0·∞ and b/(4π) is never formed (it underflows for tiny r).
     """
-    B = np.maximum(r + (1 - r) * (v + v2) - (2 - r) * v * v2, 0)
-    x1 = r / (r + (1 - r) * v) / v
-    x2 = r / (r + (1 - r) * v2) / v2
-    return (1 - r) / pi * (x1 * x2) * B
+    B = max(r + (1.0 - r) * (v + v2) - (2.0 - r) * v * v2, 0.0)
+    x1 = r / max(r + (1.0 - r) * v, D_FLOOR) / v
+    x2 = r / max(r + (1.0 - r) * v2, D_FLOOR) / v2
+    return (1.0 - r) / math.pi * (x1 * x2) * B
 
 
-def _slab_directional(t, s2, hx, hy, v, v2, r, p, dt, reinject=False):
+@jit
+def slab_directional(t, s2, hx, hy, v, v2, r, p, reinject):
     """One slab's directional factor without the mirror part: a/π + b·G G' Z A/(4π v v')
-    [+ b·(1 − G G')/(4π v v') with ``reinjection``], capped at a quarter of the dtype's largest value."""
-    a, b, _ = split_weights(float(r))
-    pi = dt(np.pi)
-    info = np.finfo(dt)
-    # floors that keep each factor finite: b·Z·A·G G'/(v v') = 4(1 − r) q² A/(d d'), q ≤ 2;
-    # d = r + (1 − r) v only drops below them for r and v both below ~1e-150 (1e-18 in float32)
-    floor = dt(1e-150) if dt == np.float64 else dt(1e-18)
-    q = zenith_ratio(t, s2, r)
-    A = np.ones_like(t) if p == 1 else azimuth_factor(hx, hy, p)
-    d1 = masking_denominator(v, r, floor)
-    d2 = masking_denominator(v2, r, floor)
-    # b Z A G G'/(4π v v') = (1 − r)/π · A · (q/d)(q/d')
-    gloss = (dt(1) - r) / pi * A * (q / d1) * (q / d2) if b > 0 else np.zeros_like(t)
-    if reinject and b > 0:
-        gloss = gloss + reinjection(v, v2, r, pi)
-    return np.minimum(dt(a) / pi + gloss, info.max / dt(4))
+    [+ b·(1 − G G')/(4π v v') with ``reinject``], capped at :data:`SLAB_CAP`.
+
+    b·Z·A·G G'/(4π v v') = (1 − r)/π · A · (q/d)(q/d') with d = r + (1 − r)v = v/G(v)
+    and q from :func:`zenith_ratio`.
+    """
+    a, b, _ = split_weights(r)
+    f = a / math.pi
+    if b > 0.0:
+        q = zenith_ratio(t, s2, r)
+        d1 = max(r + (1.0 - r) * v, D_FLOOR)
+        d2 = max(r + (1.0 - r) * v2, D_FLOOR)
+        f += (1.0 - r) / math.pi * azimuth_factor(hx, hy, p) * (q / d1) * (q / d2)
+        if reinject:
+            f += reinjection(v, v2, r)
+    return min(f, SLAB_CAP)
+
+
+@jit
+def schlick_kernel(wix, wiy, wiz, wox, woy, woz, p, c):
+    """Schlick 1994, one or two slabs, per pair (engine protocol, :mod:`brdfkit.engine`).
+
+    ``p`` = [color (3), r, p, color2 (3), r2, p2]; ``c`` = [layers (0 single, 1 double), reinjection].
+    """
+    hx, hy, hz = half_vector_c(wix, wiy, wiz, wox, woy, woz)
+    t = min(max(hz, 0.0), 1.0)
+    s2 = hx * hx + hy * hy
+    u = min(max(dot3(wix, wiy, wiz, hx, hy, hz), 0.0), 1.0)
+    rein = c[1] != 0
+    D = slab_directional(t, s2, hx, hy, wiz, woz, p[3], p[4], rein)
+    S0 = f_schlick(p[0], u)
+    S1 = f_schlick(p[1], u)
+    S2 = f_schlick(p[2], u)
+    r0 = S0 * D
+    r1 = S1 * D
+    r2 = S2 * D
+    if c[0] == 1:
+        D2 = slab_directional(t, s2, hx, hy, wiz, woz, p[8], p[9], rein)
+        r0 += (1.0 - S0) * f_schlick(p[5], u) * D2
+        r1 += (1.0 - S1) * f_schlick(p[6], u) * D2
+        r2 += (1.0 - S2) * f_schlick(p[7], u) * D2
+    return r0, r1, r2
 
 
 @register
@@ -262,19 +288,10 @@ class Schlick(BRDF):
         ),
     )
 
-    def _eval(self, wi, wo, p):
-        dt = wi.dtype.type
-        t, s2, u, hx, hy = _half_terms(wi, wo)
-        v, v2 = wi[..., 2], wo[..., 2]
-        rein = bool(p["reinjection"])
-        S = fresnel_schlick(p["color"], u[..., None])
-        D = _slab_directional(t, s2, hx, hy, v, v2, p["r"], p["p"], dt, rein)[..., None]
-        f = S * D
-        if p["layers"] == "double":
-            S2 = fresnel_schlick(p["color2"], u[..., None])
-            D2 = _slab_directional(t, s2, hx, hy, v, v2, p["r2"], p["p2"], dt, rein)[..., None]
-            f = f + (dt(1) - S) * S2 * D2
-        return f
+    kernel = staticmethod(schlick_kernel)
+
+    def kernel_args(self):
+        return self._pack(("color", "r", "p", "color2", "r2", "p2"), ("layers", "reinjection"))
 
     def delta_reflectance(self, w) -> np.ndarray:
         """The ideal-mirror part (see :meth:`mirror_reflectance`), for albedo and energy checks."""
