@@ -49,9 +49,10 @@ never produce NaN: Beckmann via ``erfc``, GGX as
 Numerics of D
 -------------
 The exponent ``tan²θ/α²`` can be huge (small α, grazing h) while ``cos⁴θ``
-underflows; D is evaluated as ``exp(−e − 4 ln h_z)`` so that it underflows to 0
-instead of becoming ``0/0`` or ``inf/inf``, in float32 as in float64. For
-``h_z <= 0`` every D here returns 0.
+underflows; the scalar sources compute in float64 and return 0 where ``h_z⁴``
+underflows (the exponential is 0 there already), so D is never ``0/0`` or
+``inf/inf``, for float32 as for float64 results. For ``h_z <= 0`` every D here
+returns 0.
 
 One source per formula
 ----------------------
@@ -89,13 +90,16 @@ def slope2(hx, hy, ax, ay):
 def d_beckmann_slopes(hx, hy, hz, ax, ay):
     """Beckmann D without the 1/π: ``exp(−(h_x²/α_x² + h_y²/α_y²)/h_z²) / (α_x α_y h_z⁴)``.
 
-    Cook & Torrance (1982, eq. 4) for α_x = α_y = m; evaluated as
-    ``exp(−e − 4 ln h_z)`` so that it underflows to 0, never 0/0. 0 for ``h_z <= 0``.
+    Cook & Torrance (1982, eq. 4) for α_x = α_y = m. 0 for ``h_z <= 0``, and 0
+    where ``h_z⁴`` underflows (the exponential has underflowed long before: for
+    α ≤ 1 and h_z < 1e-70, e > 1e140), so never 0/0.
     """
-    if hz <= 0.0:
+    hz2 = hz * hz
+    hz4 = hz2 * hz2
+    if hz <= 0.0 or hz4 <= 0.0:
         return 0.0
-    e = slope2(hx, hy, ax, ay) / (hz * hz)
-    return math.exp(-e - 4.0 * math.log(hz)) / (ax * ay)
+    e = slope2(hx, hy, ax, ay) / hz2
+    return math.exp(-e) / (ax * ay * hz4)
 
 
 @jit
@@ -108,10 +112,12 @@ def d_beckmann(hx, hy, hz, ax, ay):
 def d_beckmann_cook(cos_h, m):
     """Cook & Torrance's (1982, eq. 4) ``exp(−(tan α/m)²)/(m² cos⁴α)`` from ``cos α``; 0 for ``cos α <= 0``."""
     c = min(cos_h, 1.0)
-    if c <= 0.0:
-        return 0.0
-    t2 = (1.0 - c * c) / (c * c)
-    return math.exp(-t2 / (m * m) - 4.0 * math.log(c)) / (m * m)
+    c2 = c * c
+    c4 = c2 * c2
+    if c <= 0.0 or c4 <= 0.0:
+        return 0.0  # the exponential has underflowed long before cos⁴α does (m ≤ 1)
+    t2 = (1.0 - c2) / c2
+    return math.exp(-t2 / (m * m)) / (m * m * c4)
 
 
 @jit

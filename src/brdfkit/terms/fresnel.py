@@ -74,10 +74,13 @@ def f_conductor(c, eta, k):
     c = min(max(c, 0.0), 1.0)
     m1 = (eta - 1.0) * (eta + 1.0) - k * k  # Re(η² − 1)
     Q = 2.0 * eta * k  # Im η² (>= 0)
-    qa = math.hypot(m1, Q)  # |η² − 1|
+    # moduli as sqrt(x² + y²), not hypot: computed in float64 from bounded parameters
+    # (eta ≤ 10, k ≤ 20), the squares neither overflow nor underflow to a wrong result,
+    # and sqrt is an LLVM intrinsic that the compiler hoists and vectorises (hypot is a libm call)
+    qa = math.sqrt(m1 * m1 + Q * Q)  # |η² − 1|
     c2 = c * c
     A = m1 + c2  # Re g²
-    mod = math.hypot(A, Q)  # |g²|
+    mod = math.sqrt(A * A + Q * Q)  # |g²|
     big = math.sqrt(0.5 * (mod + abs(A)))  # the larger of Re g, Im g
     small = 0.5 * abs(Q) / big if big > 0.0 else 0.0
     if A >= 0.0:
@@ -93,7 +96,9 @@ def f_conductor(c, eta, k):
     if ds == 0.0 or dp == 0.0:
         return 0.0
     rs = qa / ds
-    rp = qa * math.hypot((m1 + 2.0) * c2 - 1.0, Q * c2) / dp
+    br = (m1 + 2.0) * c2 - 1.0  # Re((η² + 1) c² − 1)
+    bi = Q * c2
+    rp = qa * math.sqrt(br * br + bi * bi) / dp
     F = 0.5 * (rs * rs + rp * rp)
     return min(max(F, 0.0), 1.0)
 
