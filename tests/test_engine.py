@@ -193,3 +193,20 @@ def test_kernels_are_cached_on_disk(tmp_path):
     second = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True)
     assert second.stdout.split() == ["2", "0"]
     assert any(tmp_path.glob("numba-*/drivers/drv_brdfkit_models_microfacet_microfacet_kernel.py"))
+
+
+def test_scalar_half_vector_matches_the_array_one_at_grazing():
+    """geometry.half_vector (numpy, for array callers) and half_vector_c (kernels) give the same h."""
+    from brdfkit import geometry as g
+
+    wi, wo = _pairs(200, seed=9)
+    extra_i = np.array([[1.0, 0.0, 1e-300], [0.6, 0.8, 0.0], [0.0, 0.0, 1.0], [0.3, 0.4, np.sqrt(0.75)]])
+    extra_o = np.array([[-1.0, 0.0, 1e-300], [-0.6, -0.8, 0.0], [0.0, 0.0, 1.0], [-0.3, -0.4, np.sqrt(0.75)]])
+    wi = np.concatenate([wi, extra_i])
+    wo = np.concatenate([wo, extra_o])
+    h = g.half_vector(wi, wo)
+    pure = reference.pure(g.half_vector_c)
+    for j in range(len(wi)):
+        hc = g.half_vector_c(*wi[j], *wo[j])
+        assert np.allclose(hc, h[j], rtol=1e-15, atol=1e-16), (wi[j], wo[j], hc, h[j])
+        assert pure(*map(float, wi[j]), *map(float, wo[j])) == hc

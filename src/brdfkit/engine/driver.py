@@ -13,9 +13,9 @@ and it lets LLVM inline the kernel into the loop.
 pairs run in parallel (``prange``; a single chunk runs inline, without the
 thread pool). Per pair the kernel is called with float64 components, and the
 result (0 where ``wi.z <= 0`` or ``wo.z <= 0``, clamped to ``lim``) stored in
-``out``. The same pass records the smallest and largest direction lengths and
-a NaN count per chunk into ``nrm`` (``(nchunks, 6)``: wi min, max, nan, wo min,
-max, nan) for the unit-direction check of ``BRDF.eval``.
+``out``. The same pass records the smallest and largest SQUARED direction
+lengths and a NaN count per chunk into ``nrm`` (``(nchunks, 6)``: wi min, max,
+nan, wo min, max, nan) for the unit-direction check of ``BRDF.eval``.
 """
 
 from __future__ import annotations
@@ -57,8 +57,8 @@ def span(wi, wo, p, c, out, lim, nrm, ch, lo, hi):
         bx = numba.float64(wo[j, 0])
         by = numba.float64(wo[j, 1])
         bz = numba.float64(wo[j, 2])
-        li = math.sqrt(ax * ax + ay * ay + az * az)
-        lo_ = math.sqrt(bx * bx + by * by + bz * bz)
+        li = ax * ax + ay * ay + az * az  # squared lengths: the check needs no sqrt per pair
+        lo_ = bx * bx + by * by + bz * bz
         inan += li != li
         onan += lo_ != lo_
         imin = min(imin, li)
@@ -137,7 +137,7 @@ def driver_for(kernel: Callable) -> Callable:
 
 
 def run(kernel: Callable, wi: np.ndarray, wo: np.ndarray, p: np.ndarray, c: np.ndarray, out: np.ndarray) -> np.ndarray:
-    """Evaluate ``kernel`` into ``out`` (flat ``(n, 3)``); returns the ``(nchunks, 6)`` length statistics."""
+    """Evaluate ``kernel`` into ``out`` (flat ``(n, 3)``); returns the ``(nchunks, 6)`` squared-length statistics."""
     n = wi.shape[0]
     nrm = np.empty((nchunks(n), 6), dtype=np.float64)
     if n == 0:

@@ -23,11 +23,11 @@ def _length_stats(w):
         x = numba.float64(w[j, 0])
         y = numba.float64(w[j, 1])
         z = numba.float64(w[j, 2])
-        n = math.sqrt(x * x + y * y + z * z)
+        n = x * x + y * y + z * z
         nan += n != n
         lmin = min(lmin, n)
         lmax = max(lmax, n)
-    return lmin, lmax, nan
+    return math.sqrt(lmin), math.sqrt(lmax), nan
 
 
 def _length_stats_np(w: np.ndarray) -> tuple[float, float, int]:
@@ -89,8 +89,8 @@ def evaluate(model, wi, wo) -> np.ndarray:
         fout = out.reshape(-1, 3)
         if engine() == "compiled":
             nrm = driver.run(kernel, fi, fo, p, c, fout)
-            check_unit(name, "wi", nrm[:, 0].min(), nrm[:, 1].max(), int(nrm[:, 2].sum()), dtype)
-            check_unit(name, "wo", nrm[:, 3].min(), nrm[:, 4].max(), int(nrm[:, 5].sum()), dtype)
+            check_unit(name, "wi", math.sqrt(nrm[:, 0].min()), math.sqrt(nrm[:, 1].max()), int(nrm[:, 2].sum()), dtype)
+            check_unit(name, "wo", math.sqrt(nrm[:, 3].min()), math.sqrt(nrm[:, 4].max()), int(nrm[:, 5].sum()), dtype)
         else:
             check_unit(name, "wi", *_length_stats_np(fi), dtype)
             check_unit(name, "wo", *_length_stats_np(fo), dtype)
