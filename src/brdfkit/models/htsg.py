@@ -176,6 +176,9 @@ WINDOW_RIGHT = (7.0, 4.0)  # m* + 7 σ_m + 4
 
 _SQRT_PI = math.sqrt(math.pi)
 _TINY = 1e-300
+#: cap on S(θ)/cos θ: reached only for cos θ < 1e-150 with σ0 below ~1e-150 (no shadowing left to
+#: cancel the 1/cos); with it the product S_i S_o |v|⁴/(cos θi cos θr) stays finite, never 0·∞
+SHADOW_OVER_COS_CAP = 1e150
 _LN_8PI = math.log(8.0 * math.pi)
 
 
@@ -372,17 +375,17 @@ def shadowing_over_cos_c(c, sigma0, tau):
     """
     c = min(max(c, 0.0), 1.0)
     if sigma0 <= 0.0:
-        return 1.0 / max(c, _TINY)
+        return min(1.0 / max(c, _TINY), SHADOW_OVER_COS_CAP)
     s = math.sqrt(max(0.0, (1.0 - c) * (1.0 + c)))
     if s > 0.0:
-        a = tau * c / (2.0 * sigma0 * s)
+        a = tau * c / (2.0 * sigma0) / s  # 2σ0·s would underflow to 0 for tiny σ0
         ea = math.exp(-min(a * a, 1e300))
         ec = math.erfc(a)
     else:
         ea = 0.0
         ec = 0.0
     den = c * (1.0 - 0.5 * ec) + sigma0 * s * ea / (_SQRT_PI * tau)
-    return (1.0 - 0.5 * ec) / max(den, _TINY)
+    return min((1.0 - 0.5 * ec) / max(den, _TINY), SHADOW_OVER_COS_CAP)
 
 
 @jit
@@ -399,7 +402,7 @@ def roughness_K(c, sigma0, tau):
     s = math.sqrt(max(0.0, (1.0 - c) * (1.0 + c)))
     t = s / max(c, 1e-150)
     if t > 0.0:
-        return t * math.erfc(tau / (2.0 * sigma0 * t))
+        return t * math.erfc(tau / (2.0 * sigma0) / t)  # 2σ0·t would underflow to 0 for tiny σ0
     return 0.0
 
 
@@ -440,7 +443,8 @@ def directional_diffuse_channel(lam_nm, eta, k, ks, sigma, tau, vz, vxy2, cos_lo
     ratio = math.exp(min(log_series_ratio(g, T), 700.0))
     F = f_conductor(cos_local, eta, k)
     q = math.pi * tau / (2.0 * lam)
-    return ks * F * geo * k2 * (q * q) * ratio
+    # the bounded factors first (ratio may underflow to 0), the large geometric one last
+    return (ks * F * k2 * (q * q) * ratio) * geo
 
 
 @jit
