@@ -104,12 +104,14 @@ b·Z = 4(1 − r) q² — so neither Z = 1/r (at h = n) nor r² is ever formed; 
 everywhere. (Before this guard r = 1e-170 gave Inf, and float32 failed from
 r ≈ 1e-19.) A is evaluated as ``hypot(hx, hy)/hypot(√p·hy, hx/√p)``, which
 never squares p (1/sqrt(p) at w = 0 for tiny p instead of p/0); at h = n w is
-undefined and A is taken as 1. d and d' are floored at 1e-150 (1e-18 in
-float32), which only matters when r and v are both below that, and each
-slab's directional factor is capped at a quarter of the largest finite float
-of the dtype: a near-mirror slab (r → 0) lit and seen at grazing incidence
-has a true value beyond any float, and the cap keeps it finite (never NaN:
-no factor is 0 where another is infinite).
+undefined and A is taken as 1. d and d' are floored at 1e-300 (which only
+matters when r and v are both below it), and each slab's directional factor is
+capped at 1e300 (:data:`SLAB_CAP`): a near-mirror slab (r → 0) lit and seen at
+grazing incidence has a true value beyond any float, and the cap keeps it finite
+(never NaN: no factor is 0 where another is infinite). The kernel computes in
+float64 for float32 input too; the engine rounds once and clamps to float32's
+largest value. The GLSL twin (float32 throughout) floors d at 1e-18, caps each
+slab at 8.5e37 and clamps r, p at 1e-37 (GL may flush subnormal uniforms to 0).
 
 A(w) is largest for w = 0, i.e. for half vectors tilted toward ±y: with
 p < 1 the facets are scratches along the tangent +x and the highlight is
