@@ -125,8 +125,11 @@ def d_ggx(hx, hy, hz, ax, ay):
     """GGX / Trowbridge-Reitz ``1/(π α_x α_y (h_x²/α_x² + h_y²/α_y² + h_z²)²)`` (Walter 2007, eq. 33; Heitz 2014, eq. 85)."""
     if hz <= 0.0:
         return 0.0
-    q = slope2(hx, hy, ax, ay) + hz * hz
-    return 1.0 / (math.pi * ax * ay * q * q)
+    q = slope2(hx, hy, ax, ay) + hz * hz  # >= 1 for a unit h and α <= 1
+    den = math.pi * ax * ay * q * q
+    if den <= 0.0:
+        return math.inf  # only for a non-unit, vanishing h (never from a kernel)
+    return 1.0 / den
 
 
 @jit
@@ -149,7 +152,10 @@ def lambda_beckmann(wx, wy, wz, ax, ay):
     if s <= 0.0:
         return 0.0
     a = wz / s
-    lam = 0.5 * (math.exp(-a * a) / (a * _SQRT_PI) - math.erfc(a))
+    den = a * _SQRT_PI
+    if den <= 0.0:
+        return math.inf  # a underflowed (w_z ~ 5e-324): fully masked, G1 = 0
+    lam = 0.5 * (math.exp(-a * a) / den - math.erfc(a))
     return max(lam, 0.0)
 
 
@@ -162,7 +168,10 @@ def lambda_ggx(wx, wy, wz, ax, ay):
     if wz <= 0.0:
         return math.inf
     s = projected_slope(wx, wy, ax, ay)
-    return (s * s) / (2.0 * wz * (math.sqrt(wz * wz + s * s) + wz))
+    den = 2.0 * wz * (math.sqrt(wz * wz + s * s) + wz)
+    if den <= 0.0:
+        return math.inf  # the denominator underflowed (w_z ~ 5e-324 at small α): fully masked, G1 = 0
+    return (s * s) / den
 
 
 #: ``distribution`` choice indices used by the kernels (the order of microfacet's ``choices``)
