@@ -41,10 +41,9 @@ from typing import Any
 
 import math
 
-import numba
 import numpy as np
 
-from ..engine import jit
+from ..engine import jit, vectorize
 from ..geometry import from_rusinkiewicz, half_vector, half_vector_c
 from ..models.base import BRDF
 from ..params import Param
@@ -95,24 +94,11 @@ def phi_d_bin(phi_d):
     return int(min(max(math.floor(fold_phi(phi_d) / math.pi * RES_PHI_D), 0.0), RES_PHI_D - 1.0))
 
 
-@numba.vectorize(["float64(float64)"], cache=True)
-def _fold_v(x):
-    return fold_phi(x)
-
-
-@numba.vectorize(["int64(float64)"], cache=True)
-def _th_v(x):
-    return theta_h_bin(x)
-
-
-@numba.vectorize(["int64(float64)"], cache=True)
-def _td_v(x):
-    return theta_d_bin(x)
-
-
-@numba.vectorize(["int64(float64)"], cache=True)
-def _pd_v(x):
-    return phi_d_bin(x)
+# array forms over the same scalar sources, compiled lazily on first use (nothing at import)
+_fold_v = vectorize(fold_phi, 1)
+_th_v = vectorize(theta_h_bin, 1)
+_td_v = vectorize(theta_d_bin, 1)
+_pd_v = vectorize(phi_d_bin, 1)
 
 
 def theta_h_index(theta_h) -> np.ndarray:
