@@ -59,6 +59,8 @@ from typing import Any, Callable
 
 import numpy as np
 
+from ..engine import jit
+
 DATA_PATH = Path(__file__).resolve().with_name("data") / "multiscatter.npz"
 DISTRIBUTIONS = ("beckmann", "ggx")
 SHADOWINGS = ("smith", "smith-correlated", "v-groove")
@@ -99,11 +101,30 @@ def albedo_row(table: np.ndarray, alpha: float) -> np.ndarray:
     return interp_uniform(np.float64(alpha), table.T, 0.0, 1.0)
 
 
+@jit
+def lookup_uniform(values, off, n, x):
+    """``values[off : off + n]`` (nodes uniform on [0, 1]) interpolated linearly at ``x`` (clamped).
+
+    The per-direction lookup of the compiled microfacet kernel: the row of missing energies
+    1 − E(μ_j) travels in the kernel's parameter array at offset ``off``.
+    """
+    s = min(max(x, 0.0), 1.0) * (n - 1)
+    i = min(int(math.floor(s)), n - 2)
+    t = s - i
+    return values[off + i] * (1.0 - t) + values[off + i + 1] * t
+
+
 def albedo_lookup(row: np.ndarray, mu):
-    """E(μ) (or 1 − E(μ)) from a row of :func:`albedo_row` (or 1 − row): linear in μ between the nodes."""
-    # the nodes are uniform from 0 to 1 except the first, which sits at MU_MIN: interpolate on the
-    # uniform grid with the first value standing for μ = 0 (E is flat there to far below 1e-3)
-    return interp_uniform(mu, row, 0.0, 1.0)
+    """E(μ) (or 1 − E(μ)) from a row of :func:`albedo_row` (or 1 − row): linear in μ between the nodes.
+
+    The nodes are uniform from 0 to 1 except the first, which sits at MU_MIN: the lookup is on
+    the uniform grid with the first value standing for μ = 0 (E is flat there to far below 1e-3).
+    Evaluated by the kernel's own scalar :func:`lookup_uniform`.
+    """
+    row = np.ascontiguousarray(row, dtype=np.float64)
+    mu = np.asarray(mu, dtype=np.float64)
+    flat = [lookup_uniform(row, 0, row.shape[-1], float(m)) for m in mu.reshape(-1)]
+    return np.asarray(flat, dtype=np.float64).reshape(mu.shape)
 
 
 def average_albedo(row: np.ndarray) -> float:
@@ -140,6 +161,7 @@ def lobe_scale(e_avg: float) -> float:
     return 1.0 / (math.pi * gap) if gap > 1e-7 else 0.0
 
 
+@jit
 def compensation(m_i, m_o, scale):
     """f_ms = scale · (1 − E(μi)) (1 − E(μo)) from the missing energies m = 1 − E; symmetric in wi, wo."""
     return scale * (m_i * m_o)
@@ -177,13 +199,6 @@ def setup(p: dict[str, Any], fresnel: Callable[[np.ndarray], np.ndarray]) -> tup
     weight = fresnel_weight(fresnel_average(fresnel), e_avg)
     ks = np.broadcast_to(np.asarray(p["ks"], dtype=np.float64), (3,))
     return 1.0 - row, ks * weight * lobe_scale(e_avg)
-
-
-def multiscatter_term(cos_i, cos_o, missing: np.ndarray, scale: np.ndarray, dtype=np.float64):
-    """The RGB compensation lobe, shape ``cos_i.shape + (3,)``, for the row and scale of :func:`setup`."""
-    m_i = albedo_lookup(missing, np.asarray(cos_i, dtype=np.float64))
-    m_o = albedo_lookup(missing, np.asarray(cos_o, dtype=np.float64))
-    return compensation(m_i[..., None], m_o[..., None], scale).astype(dtype, copy=False)
 
 
 GLSL_BEGIN = "// BEGIN multiscatter tables"
@@ -276,6 +291,6 @@ def build_tables(path: Path = DATA_PATH, level: str = "fine") -> dict[str, np.nd
 
 __all__ = [
     "albedo_row", "albedo_lookup", "average_albedo", "fresnel_average", "fresnel_weight", "lobe_scale",
-    "compensation", "table", "setup", "multiscatter_term", "glsl_tables", "write_glsl_tables", "build_tables",
+    "compensation", "lookup_uniform", "table", "setup", "glsl_tables", "write_glsl_tables", "build_tables",
     "mu_grid", "alpha_grid", "DISTRIBUTIONS", "SHADOWINGS",
 ]
