@@ -147,7 +147,7 @@ def test_reference_runs_the_same_source_uncompiled():
     assert k.__globals__["d_of"].__code__ is D.d_of.py_func.__code__
     assert not hasattr(k.__globals__["d_of"].__globals__["d_ggx"], "py_func")
     # and it runs on plain Python floats
-    r, g, b = k(0.0, 0.0, 1.0, 0.0, 0.0, 1.0, [0.2, 0.2] + [1.5] * 3 + [0.0] * 3 + [0.04] * 3 + [0.0] * 3 + [1.0] * 3, [1, 0, 2])
+    r, g, b = k(0.0, 0.0, 1.0, 0.0, 0.0, 1.0, [0.2, 0.2] + [1.5] * 3 + [0.0] * 3 + [0.04] * 3 + [0.0] * 3 + [1.0] * 3, [1, 0, 2, 0])
     assert isinstance(r, float) and r == pytest.approx(0.04 / (4 * np.pi * 0.04), rel=1e-12)
 
 

@@ -74,10 +74,13 @@ def test_bad_scene_is_a_one_line_error_naming_the_field(case, tmp_path, capsys):
     assert not out.exists()
 
 
-def test_environment_key_is_left_open_for_image_based_lighting():
-    scene, _ = sc.scene_from_json({"mesh": {"builtin": "sphere", "segments": 8, "rings": 4}, "size": [8, 8],
-                                   "environment": {"file": "sky.hdr"}})
+def test_environment_field_is_validated_like_the_others():
+    base = {"mesh": {"builtin": "sphere", "segments": 8, "rings": 4}, "size": [8, 8], "shading": "phong",
+            "material": {"model": "lambert", "params": {"kd": 0.5}}}
+    scene, _ = sc.scene_from_json({**base, "environment": {"name": "furnace"}})
     assert scene.size == (8, 8)
+    with pytest.raises(ValueError, match="environment: unknown field.*file"):
+        sc.scene_from_json({**base, "environment": {"file": "sky.hdr"}})
 
 
 def test_tessellation_is_bounded_at_its_edges():
