@@ -94,7 +94,7 @@ def test_reciprocal_for_random_parameters():
 
 
 def test_always_finite_and_non_negative_even_with_overflowing_lobes():
-    m = bk.model("lafortune", kd=1.0, ks_1=1e6, cx_1=10.0, cy_1=10.0, cz_1=10.0, n_1=1e6)
+    m = bk.model("lafortune", kd=1.0, ks_1=1e6, cx_1=100.0, cy_1=100.0, cz_1=100.0, n_1=1e5)
     rng = np.random.default_rng(0)
     wi, wo = _unit(rng, 1000), _unit(rng, 1000)
     for dt in (np.float64, np.float32):
