@@ -68,10 +68,12 @@ def main() -> int:
     w0 = time.perf_counter()
     tab = F.table(args.material)
     t_tab = time.perf_counter() - w0
-    w0 = time.perf_counter()
-    r = F.fit("blinn-phong", args.material, data=tab, samples="table")
-    print(f"table-scale fit, blinn-phong ← {args.material}: {len(tab)} bins (tabulated in {t_tab:.2f} s), "
-          f"fit {time.perf_counter() - w0:.2f} s, error {r.error:.5g}, {r.nfev} evaluations")
+    print(f"table of {args.material}: {len(tab)} bins within 80° (tabulated in {t_tab:.2f} s)")
+    for name, fixed in (MODELS[4], MODELS[0]):
+        w0 = time.perf_counter()
+        r = F.fit(name, args.material, fixed=fixed, data=tab, samples="table")
+        print(f"table-scale fit, {name} ← {args.material}: {time.perf_counter() - w0:.2f} s, "
+              f"error {r.error:.5g}, {r.nfev} evaluations")
 
     if args.scaling:
         from brdfkit.measured.commands import measured_names
