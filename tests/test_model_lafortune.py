@@ -114,3 +114,23 @@ def test_bad_parameters_raise_one_line_errors():
         bk.model("lafortune", n_1=-1.0)
     with pytest.raises(ValueError, match="ks_2"):
         bk.model("lafortune", ks_2=[0.1, -0.2, 0.1])
+
+
+@pytest.mark.parametrize("lobes", [1, 2, 3])
+def test_glsl_twin_with_every_lobe_count(lobes):
+    """The shader (through real OpenGL) equals numpy with 1, 2 and 3 non-zero lobes."""
+    from brdfkit.render import glsl
+
+    P = dict(kd=[0.1, 0.2, 0.3], lobes=lobes, ks_1=[0.5, 0.4, 0.3], cx_1=-1.05, cy_1=-1.05, cz_1=1.0, n_1=40.0,
+             ks_2=[0.1, 0.3, 0.2], cx_2=0.7, cy_2=0.9, cz_2=0.8, n_2=3.0,
+             ks_3=[2.0, 1.0, 0.5], cx_3=-3.0, cy_3=-2.0, cz_3=1.0, n_3=2.5)
+    m = bk.model("lafortune", **P)
+    rng = np.random.default_rng(lobes)
+    wi, wo = _unit(rng, 3000).astype(np.float32), _unit(rng, 3000).astype(np.float32)
+    g = glsl.eval_glsl(m, wi, wo)
+    f = m.eval(wi.astype(np.float64), wo.astype(np.float64))
+    np.testing.assert_allclose(g, f, rtol=2e-4, atol=1e-7)
+    # the lobes switch on as counted: with more lobes the values change
+    if lobes > 1:
+        less = bk.model("lafortune", **dict(P, lobes=lobes - 1)).eval(wi, wo)
+        assert np.abs(less - f).max() > 1e-3
