@@ -115,3 +115,20 @@ def test_default_fit_reaches_the_dense_multistart_minimum(source, model, fixed):
     dense = bk.fit(model, source, fixed=fixed, data=data, seed=105, starts=32, candidates=400)
     assert dense.starts == 32
     assert r.error <= dense.error * 1.01, (r.error, dense.error, dense.start_errors)
+
+
+def test_cli_table_and_two_lobes(capsys):
+    import json
+
+    from brdfkit.cli import main
+
+    assert main(["fit", "nielsen/bluebook", "-m", "lambert", "--samples", "table", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["samples"] > 500000 and out["search_samples"] == F.TABLE_SEARCH_SAMPLES and out["at_bound"] == []
+    assert main(["fit", "nielsen/bluebook", "-m", "ward", "--lobes", "2", "--samples", "300", "--starts", "1",
+                 "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["model"] == "ward+lobe2" and out["lobes"] == 2 and "alpha_x_2" in out["params"]
+    assert main(["fit", "nielsen/bluebook", "-m", "ward:normalization=dur", "--samples", "300", "--starts", "1",
+                 "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["params"]["normalization"] == "dur"
