@@ -26,7 +26,8 @@ Numerics: ``max(0, d)^n`` is ``exp(n·ln d)`` for ``d > 0`` and 0 otherwise (als
 for n = 0: the lobe is one-sided). ``|C|`` greater than 1 raised to a large n
 would overflow, so the exponent ``n·ln d`` is capped at :data:`LOG_CAP` = 60
 (a lobe value of e^60 ≈ 1.1e26, some twenty orders of magnitude above any
-measured reflectance): every value stays finite, also in float32.
+measured reflectance), and ``ks_k`` ≤ 1e6: every value stays below 4e32, finite
+also in float32.
 
 Fitting: for ``cz > 0`` the lobe ``ks·d^n`` depends only on ``ks·cz^n`` and on
 the ratios ``cx/cz``, ``cy/cz``; ``cz_k`` is therefore not a fitted parameter
@@ -39,7 +40,7 @@ parameter   kind    default    range          meaning
 ==========  ======  =========  =============  ===========================================
 kd          rgb     0.2        [0, 1]         diffuse albedo (kd/π)
 lobes       int     1          [1, 3]         number of lobes used
-ks_k        rgb     0.5, 0, 0  [0, ∞)         lobe k's weight ρ_s (fitted in [1e-6, 1e6])
+ks_k        rgb     0.5, 0, 0  [0, 1e6]       lobe k's weight ρ_s (fitted in [1e-6, 1e6])
 cx_k        scalar  -1         [-100, 100]    C_x of lobe k (along the tangent)
 cy_k        scalar  -1         [-100, 100]    C_y of lobe k (along the bitangent)
 cz_k        scalar  1          [-100, 100]    C_z of lobe k (along the normal; not fitted)
@@ -77,7 +78,7 @@ def cosine_lobe(d, n):
 
 def _lobe_params(k: int, ks_default: float) -> tuple[Param, ...]:
     return (
-        Param(f"ks_{k}", "rgb", ks_default, (0.0, np.inf), "", f"weight ρ_s of lobe {k}",
+        Param(f"ks_{k}", "rgb", ks_default, (0.0, 1e6), "", f"weight ρ_s of lobe {k}",
               fit_range=(1e-6, 1e6), log_scale=True),
         Param(f"cx_{k}", "scalar", -1.0, (-100.0, 100.0), "", f"C_x of lobe {k} (tangent)"),
         Param(f"cy_{k}", "scalar", -1.0, (-100.0, 100.0), "", f"C_y of lobe {k} (bitangent)"),
