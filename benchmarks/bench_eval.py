@@ -1,34 +1,28 @@
-"""Evaluation throughput of every registered model, float64 and float32.
+"""Evaluation throughput of every registered model: the compiled engine beside the reference.
 
     .venv/bin/python benchmarks/bench_eval.py            # rich table
     .venv/bin/python benchmarks/bench_eval.py --json     # JSON list on stdout
     .venv/bin/python benchmarks/bench_eval.py --models ward,phong --log2n 18 --repeat 5
 
-Each model is evaluated at its default parameters on the same 2^20 (by
-default) random direction pairs, uniform over the upper hemisphere, in one
-batched ``m.eval(wi, wo)`` call; the figure is pairs per second of the best of
-``--repeat`` timed calls after one warm-up call (a model whose warm-up call
-takes more than 5 s is timed by that call alone). Wall-clock throughput is the
-headline; throughput per second of this process's CPU time (user + system) is
-shown too, since it is less disturbed by other processes on a shared machine.
-Plain numpy, no threads beyond what numpy itself uses. The machine's load
-average is printed with the table: figures taken on a busy machine are lower
-bounds.
+Per model, at default parameters, on the same random direction pairs (uniform over
+the upper hemisphere):
 
-Measured 2026-11-22 on the development machine while quiet (2 vCPUs AMD EPYC, numpy 2.4.6,
-Python 3.11.7, load average 0.0-0.4), 2^20 pairs, best of 3, millions of evaluations per second:
+* compiled engine (``bk.set_engine("compiled")``, numba, all cores), float64 and
+  float32: one batched ``m.eval(wi, wo)`` on 2^20 pairs (``--log2n``), best of
+  ``--repeat`` timed calls after a warm-up call (which also loads or compiles the
+  kernel), in millions of evaluations per second (wall clock);
+* one-pair latency of the compiled engine: the median over 2000 calls of
+  ``m.eval(wi[0], wo[0])`` (float64, shape (3,)), in microseconds — the whole
+  Python call, argument checks included;
+* reference engine (``bk.set_engine("reference")``: the same kernel source run
+  uncompiled, pair by pair in Python), float64, on 2^10 pairs (``--ref-log2n``);
+* the ratio compiled/reference, and the ratio to the numpy implementation that
+  preceded the engine (its float64/float32 figures measured with this script on
+  2026-11-22, kept in :data:`NUMPY_BEFORE`).
 
-    model               float64  float32
-    lambert               96.16   106.25
-    phong                 16.73    32.05
-    blinn-phong           11.24    15.32
-    microfacet             2.52     3.54
-    cook-torrance          3.37     3.90
-    oren-nayar             8.13    15.10
-    ward                   8.05    10.38
-    schlick                6.42     8.11
-    htsg                   0.36     0.44
-    ashikhmin-shirley      5.73     7.74
+The machine's load average is printed with the table: on the shared 2-core
+development machine figures vary by ±30 % from run to run, and those taken on a
+busy machine are lower bounds.
 """
 
 from __future__ import annotations
@@ -37,10 +31,26 @@ import argparse
 import json
 import os
 import platform
+import statistics
 import sys
 import time
 
 import numpy as np
+
+#: Meval/s of the numpy implementation before the engine (float64, float32), 2^20 pairs,
+#: best of 3, measured 2026-11-22 on the development machine while quiet (load 0.0-0.4).
+NUMPY_BEFORE = {
+    "lambert": (96.16, 106.25),
+    "phong": (16.73, 32.05),
+    "blinn-phong": (11.24, 15.32),
+    "microfacet": (2.52, 3.54),
+    "cook-torrance": (3.37, 3.90),
+    "oren-nayar": (8.13, 15.10),
+    "ward": (8.05, 10.38),
+    "schlick": (6.42, 8.11),
+    "htsg": (0.36, 0.44),
+    "ashikhmin-shirley": (5.73, 7.74),
+}
 
 
 def directions(n: int, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
@@ -56,15 +66,15 @@ def _timed(m, wi, wo) -> tuple[float, float]:
     return time.perf_counter() - w0, time.process_time() - c0
 
 
-def time_eval(m, wi, wo, repeat: int, budget_s: float = 5.0) -> tuple[float, float]:
-    """Best wall time and best CPU time (this process) of up to ``repeat`` calls after a warm-up.
+def time_eval(m, wi, wo, repeat: int, budget_s: float = 5.0, warm: bool = True) -> tuple[float, float]:
+    """Best wall time and best CPU time (this process) of up to ``repeat`` calls after an untimed warm-up.
 
-    A slow model (a warm-up call longer than ``budget_s``) is not repeated: its
-    warm-up call is the measurement, so the whole benchmark stays within minutes.
+    The warm-up loads (or compiles) the kernel; at least one timed call is made,
+    more until ``repeat`` or ``budget_s`` seconds of timed calls.
     """
-    wall, cpu = _timed(m, wi, wo)
-    if wall > budget_s:
-        return wall, cpu
+    if warm:
+        m.eval(wi[:64], wo[:64])
+        m.eval(wi, wo)
     best_wall = best_cpu = float("inf")
     spent = 0.0
     for _ in range(repeat):
@@ -76,7 +86,19 @@ def time_eval(m, wi, wo, repeat: int, budget_s: float = 5.0) -> tuple[float, flo
     return best_wall, best_cpu
 
 
-def run(models: list[str], n: int, repeat: int, progress: bool = True) -> list[dict]:
+def one_pair_us(m, wi, wo, calls: int = 2000) -> float:
+    """Median wall time of one ``m.eval`` of a single pair, microseconds."""
+    a, b = wi[0].copy(), wo[0].copy()
+    m.eval(a, b)
+    ts = []
+    for _ in range(calls):
+        t0 = time.perf_counter()
+        m.eval(a, b)
+        ts.append(time.perf_counter() - t0)
+    return statistics.median(ts) * 1e6
+
+
+def run(models: list[str], n: int, repeat: int, n_ref: int = 1024, progress: bool = True) -> list[dict]:
     import brdfkit as bk
 
     wi64, wo64 = directions(n)
@@ -84,20 +106,38 @@ def run(models: list[str], n: int, repeat: int, progress: bool = True) -> list[d
     rows = []
     from rich.progress import Progress
 
-    with Progress(transient=True, disable=not progress, console=_stderr_console()) as bar:
-        task = bar.add_task("benchmarking", total=2 * len(models))
-        for name in models:
-            m = bk.model(name)
-            row = {"model": name, "n": n}
-            for tag, (wi, wo) in (("float64", (wi64, wo64)), ("float32", (wi32, wo32))):
-                bar.update(task, description=f"{name} {tag}")
-                wall, cpu = time_eval(m, wi, wo, repeat)
-                row[f"{tag}_seconds"] = wall
-                row[f"{tag}_evals_per_s"] = n / wall
-                row[f"{tag}_cpu_seconds"] = cpu
-                row[f"{tag}_evals_per_cpu_s"] = n / cpu if cpu > 0 else None
+    old = bk.engine()
+    try:
+        with Progress(transient=True, disable=not progress, console=_stderr_console()) as bar:
+            task = bar.add_task("benchmarking", total=4 * len(models))
+            for name in models:
+                m = bk.model(name)
+                row = {"model": name, "n": n, "n_reference": n_ref}
+                bk.set_engine("compiled")
+                for tag, (wi, wo) in (("float64", (wi64, wo64)), ("float32", (wi32, wo32))):
+                    bar.update(task, description=f"{name} compiled {tag}")
+                    wall, cpu = time_eval(m, wi, wo, repeat)
+                    row[f"{tag}_seconds"] = wall
+                    row[f"{tag}_evals_per_s"] = n / wall
+                    row[f"{tag}_cpu_seconds"] = cpu
+                    row[f"{tag}_evals_per_cpu_s"] = n / cpu if cpu > 0 else None
+                    before = NUMPY_BEFORE.get(name)
+                    k = 0 if tag == "float64" else 1
+                    row[f"{tag}_vs_numpy_before"] = (n / wall / 1e6 / before[k]) if before else None
+                    bar.advance(task)
+                bar.update(task, description=f"{name} one pair")
+                row["one_pair_us"] = one_pair_us(m, wi64, wo64)
                 bar.advance(task)
-            rows.append(row)
+                bk.set_engine("reference")
+                bar.update(task, description=f"{name} reference")
+                m.eval(wi64[:8], wo64[:8])  # warm-up: the reference's own one-time setup (rebuilt functions, the unit check)
+                wall, _ = time_eval(m, wi64[:n_ref], wo64[:n_ref], 1, budget_s=0.0, warm=False)
+                row["reference_float64_evals_per_s"] = n_ref / wall
+                row["compiled_vs_reference_float64"] = row["float64_evals_per_s"] / row["reference_float64_evals_per_s"]
+                bar.advance(task)
+                rows.append(row)
+    finally:
+        bk.set_engine(old)
     return rows
 
 
@@ -121,6 +161,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--log2n", type=int, default=20, help="number of direction pairs is 2^LOG2N (default 20)")
     ap.add_argument("--repeat", type=int, default=3, help="timed calls per model and dtype; the best counts")
     ap.add_argument("--models", default="", help="comma-separated registry names (default: every model)")
+    ap.add_argument("--ref-log2n", type=int, default=10, help="pairs for the (slow) reference engine: 2^N (default 10)")
     ap.add_argument("--json", action="store_true", help="print a JSON list instead of the table")
     a = ap.parse_args(argv)
     if not 4 <= a.log2n <= 26:
@@ -132,7 +173,9 @@ def main(argv: list[str] | None = None) -> int:
         if s not in bk.models():
             ap.error(f"unknown model {s!r}; valid models: {', '.join(bk.models())}")
 
-    rows = run(names, 2**a.log2n, a.repeat, progress=not a.json)
+    if not 4 <= a.ref_log2n <= 20:
+        ap.error("--ref-log2n must lie in [4, 20]")
+    rows = run(names, 2**a.log2n, a.repeat, n_ref=2**a.ref_log2n, progress=not a.json)
     if a.json:
         print(json.dumps(rows, indent=2))
         return 0
@@ -140,37 +183,38 @@ def main(argv: list[str] | None = None) -> int:
     from rich.console import Console
     from rich.table import Table
 
+    import numba
+
     t = Table(
-        title=f"brdfkit eval throughput: 2^{a.log2n} direction pairs, default parameters, best of {a.repeat}",
+        title=f"brdfkit eval throughput: compiled engine on 2^{a.log2n} pairs (best of {a.repeat}), "
+        f"reference on 2^{a.ref_log2n}, default parameters, Meval/s",
         title_justify="left",
-        caption=f"numpy {np.__version__}, Python {platform.python_version()}, {platform.machine()}, "
-        f"{os.cpu_count()} CPUs, load average {_load()}",
+        caption=f"numpy {np.__version__}, numba {numba.__version__} ({numba.get_num_threads()} threads), "
+        f"Python {platform.python_version()}, {platform.machine()}, {os.cpu_count()} CPUs, load average {_load()}; "
+        "x numpy = compiled / the numpy implementation before the engine (NUMPY_BEFORE)",
         caption_justify="left",
     )
-    t.add_column("model", no_wrap=True)
-    t.add_column("float64 Meval/s", justify="right")
-    t.add_column("float32 Meval/s", justify="right")
-    t.add_column("float64 ms/call", justify="right")
-    t.add_column("float32 ms/call", justify="right")
-    t.add_column("float64 CPU Meval/s", justify="right")
-    t.add_column("float32 CPU Meval/s", justify="right")
+    for col in ("model", "compiled f64", "compiled f32", "one pair µs", "reference f64",
+                "compiled/ref", "f64 x numpy", "f32 x numpy", "f64 CPU Meval/s"):
+        t.add_column(col, justify="left" if col == "model" else "right", no_wrap=True)
 
     def mev(x):
-        return "n/a" if x is None else f"{x / 1e6:.2f}"
+        return "n/a" if x is None else f"{x / 1e6:.3g}"
 
-    def ms(seconds):
-        v = seconds * 1e3
-        return f"{v:.0f}" if v >= 10 else f"{v:.3g}"
+    def ratio(x):
+        return "n/a" if x is None else f"{x:.3g}x"
 
     for r in rows:
         t.add_row(
             r["model"],
             mev(r["float64_evals_per_s"]),
             mev(r["float32_evals_per_s"]),
-            ms(r["float64_seconds"]),
-            ms(r["float32_seconds"]),
+            f"{r['one_pair_us']:.1f}",
+            mev(r["reference_float64_evals_per_s"]),
+            ratio(r["compiled_vs_reference_float64"]),
+            ratio(r["float64_vs_numpy_before"]),
+            ratio(r["float32_vs_numpy_before"]),
             mev(r["float64_evals_per_cpu_s"]),
-            mev(r["float32_evals_per_cpu_s"]),
         )
     Console(width=max(150, Console().width)).print(t)
     return 0

@@ -364,8 +364,9 @@ def test_eval_glsl_large_batches_and_broadcasting():
     m = bk.model("lambert", kd=[0.1, 0.2, 0.3])
     rng = np.random.default_rng(3)
     n = glsl._CHUNK * 2 + 12345  # several transform-feedback draws
-    wi = rng.normal(size=(n, 3)).astype(np.float32)
-    wo = rng.normal(size=(n, 3)).astype(np.float32)
+    # unit directions (m.eval rejects others, SPEC), in both hemispheres
+    wi = bk.geometry.normalize(rng.normal(size=(n, 3))).astype(np.float32)
+    wo = bk.geometry.normalize(rng.normal(size=(n, 3))).astype(np.float32)
     g = glsl.eval_glsl(m, wi, wo)
     np.testing.assert_array_equal(g, m.eval(wi, wo))
     # broadcasting (..., 3) like model.eval

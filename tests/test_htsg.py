@@ -297,8 +297,8 @@ def test_off_specular_peaks():
 
 def test_contract_dtype_zero_below_and_parts():
     m = bk.model("htsg", kd=0.2)
-    wi = np.array([[0.3, 0.1, 0.9], [0.3, 0.1, -0.2]], dtype=np.float32)
-    wo = np.array([[-0.5, 0.0, 0.8], [0.0, 0.0, 1.0]], dtype=np.float32)
+    wi = bk.geometry.normalize(np.array([[0.3, 0.1, 0.9], [0.3, 0.1, -0.2]])).astype(np.float32)
+    wo = bk.geometry.normalize(np.array([[-0.5, 0.0, 0.8], [0.0, 0.0, 1.0]])).astype(np.float32)
     f = m.eval(wi, wo)
     assert f.dtype == np.float32 and f.shape == (2, 3)
     assert np.all(f[1] == 0) and np.all(f[0] > 0.2 / np.pi)
@@ -321,3 +321,24 @@ def test_registry_and_parameters():
         bk.model("htsg", wavelengths=[650, 550, 50])
     with pytest.raises(ValueError, match="sigma0"):
         bk.model("htsg", sigma0=-1)
+
+
+def test_ks_scales_the_surface_reflection_not_the_uniform_diffuse():
+    """ks (a fitting parameter, 1 = the 1991 model) multiplies ρ_dd and the coherent specular part."""
+    rng = np.random.default_rng(91)
+    wi = bk.geometry.random_unit_vectors(300, rng)
+    wo = bk.geometry.random_unit_vectors(300, rng)
+    base = bk.model("htsg", sigma0=0.3, tau=2.0, kd=0.2)
+    scaled = bk.model("htsg", sigma0=0.3, tau=2.0, kd=0.2, ks=[0.5, 2.0, 0.0])
+    ks = np.array([0.5, 2.0, 0.0])
+    dd = base.eval(wi, wo) - 0.2 / np.pi
+    np.testing.assert_allclose(scaled.eval(wi, wo), ks * dd + 0.2 / np.pi, rtol=1e-12, atol=1e-15)
+    np.testing.assert_allclose(scaled.specular_reflectance(wi), ks * base.specular_reflectance(wi), rtol=1e-13)
+
+
+def test_fit_ranges_lie_inside_the_ranges():
+    spec = {p.name: p for p in bk.registry.get("htsg").spec}
+    for name in ("sigma0", "tau", "ks"):
+        lo, hi = spec[name].fit_range
+        assert spec[name].range[0] <= lo < hi <= spec[name].range[1]
+    assert spec["sigma0"].fit_range[0] > 0  # σ0 = 0 is a mirror: nothing left to fit

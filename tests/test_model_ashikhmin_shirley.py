@@ -136,3 +136,51 @@ def test_audit_anisotropic_exponent(phi, expo):
     spec = math.sqrt(11 * 41) / (8 * math.pi) * c**expo / (c * 1.0) * (rs + (1 - rs) * (1 - c) ** 5)
     wi = vec(math.degrees(2 * math.atan(0.1)), phi)
     assert math.isclose(m.eval(wi, np.array([0.0, 0.0, 1.0]))[0], spec, rel_tol=1e-12)
+
+
+# --- variant "ngan" (Ngan, Durand & Matusik 2005) ----------------------------------------------------
+def _ngan_by_hand(wi, wo, kd, ks, f0, nu, nv):
+    """kd/π + ks·sqrt((nu+1)(nv+1))/(8π)·(n·h)^e/((h·k) max(n·wi, n·wo))·F_schlick(f0, h·k)."""
+    h = [wi[k] + wo[k] for k in range(3)]
+    ln = math.sqrt(sum(c * c for c in h))
+    h = [c / ln for c in h]
+    phi_h = math.atan2(h[1], h[0])
+    expo = nu * math.cos(phi_h) ** 2 + nv * math.sin(phi_h) ** 2
+    hk = sum(h[k] * wi[k] for k in range(3))
+    F = f0 + (1 - f0) * (1 - hk) ** 5
+    lobe = math.sqrt((nu + 1) * (nv + 1)) / (8 * math.pi) * h[2] ** expo / (hk * max(wi[2], wo[2]))
+    return kd / math.pi + ks * lobe * F
+
+
+@pytest.mark.parametrize("pair", [((35, 20), (50, 170)), ((10, 0), (15, 100)), ((70, 45), (60, 250))])
+@pytest.mark.parametrize("nu,nv", [(100.0, 100.0), (10.0, 400.0)])
+def test_ngan_value_by_hand(pair, nu, nv):
+    (ti, pi_), (to, po) = pair
+    wi, wo = vec(ti, pi_), vec(to, po)
+    kd, ks, f0 = [0.1, 0.4, 0.7], [0.3, 0.6, 2.0], [0.02, 0.5, 0.9]
+    m = bk.model("ashikhmin-shirley", variant="ngan", kd=kd, ks=ks, f0=f0, nu=nu, nv=nv)
+    expect = [_ngan_by_hand(wi, wo, kd[c], ks[c], f0[c], nu, nv) for c in range(3)]
+    np.testing.assert_allclose(m.eval(wi, wo), expect, rtol=1e-12)
+
+
+def test_ngan_with_no_lobe_is_lambert():
+    wi, wo = random_upper(400, 71), random_upper(400, 72)
+    m = bk.model("ashikhmin-shirley", variant="ngan", kd=[0.2, 0.5, 0.8], ks=0.0)
+    np.testing.assert_allclose(m.eval(wi, wo), bk.model("lambert", kd=[0.2, 0.5, 0.8]).eval(wi, wo), rtol=1e-15)
+
+
+def test_ngan_lobe_equals_the_paper_lobe_with_its_fresnel():
+    """The two variants share the specular lobe: with kd = 0, ks = 1 and f0 = R_s, ngan is the paper less ρ_d."""
+    wi, wo = random_upper(400, 73), random_upper(400, 74)
+    kw = dict(nu=50.0, nv=300.0)
+    paper_spec = bk.model("ashikhmin-shirley", rd=0.0, rs=0.3, **kw).eval(wi, wo)
+    ngan = bk.model("ashikhmin-shirley", variant="ngan", kd=0.0, ks=1.0, f0=0.3, **kw).eval(wi, wo)
+    np.testing.assert_allclose(ngan, paper_spec, rtol=1e-14)
+
+
+def test_ngan_reciprocal_and_active_params():
+    wi, wo = random_upper(1000, 75), random_upper(1000, 76)
+    m = bk.model("ashikhmin-shirley", variant="ngan", kd=0.3, ks=[0.5, 1.0, 2.0], f0=0.1, nu=20.0, nv=800.0)
+    np.testing.assert_allclose(m.eval(wi, wo), m.eval(wo, wi), rtol=1e-12)
+    assert "rd" not in m.active_params() and "ks" in m.active_params()
+    assert "ks" not in bk.model("ashikhmin-shirley").active_params()

@@ -176,3 +176,96 @@ def test_audit_double_slab_with_the_half_vector_on_the_normal():
     D, D2 = 1.92 / math.pi, (8 / 9) / math.pi
     m = bk.model("schlick", layers="double", color=0.04, r=0.25, p=1.0, color2=0.6, r2=0.5, p2=1.0)
     assert math.isclose(m.eval(vec(60, 0), vec(60, 180))[0], S * D + (1 - S) * S2 * D2, rel_tol=1e-12)
+
+
+# --- issue 14: Z and A guarded down to the smallest positive float --------------------------------
+TINY64 = float(np.finfo(np.float64).smallest_subnormal)
+TINY32 = float(np.finfo(np.float32).smallest_subnormal)
+
+
+@pytest.mark.parametrize("r", [1e-170, 1e-300, TINY64])
+def test_tiny_roughness_at_the_normal_half_vector_is_the_formula_limit(r):
+    """At h = n: b·Z·G G'/(4π v v') = 4r(1 − r)·(1/r)/(4π (r + (1 − r)v)(r + (1 − r)v')) — finite
+    for every r > 0 (r = 1e-170 gave Inf before the guard)."""
+    wi, wo = np.array([0.5, 0.0, math.sqrt(0.75)]), np.array([-0.5, 0.0, math.sqrt(0.75)])  # h == n exactly
+    m = bk.model("schlick", r=r, color=0.8)
+    v = wi[2]
+    d = r + (1 - r) * v
+    S = 0.8 + 0.2 * (1 - v) ** 5  # u = h·wi = v at h = n
+    expect = S * (1 - r) / (math.pi * d * d)
+    np.testing.assert_allclose(m.eval(wi, wo), [expect] * 3, rtol=1e-12)
+
+
+@pytest.mark.parametrize("r", [1e-19, 1e-30, TINY32])
+def test_tiny_roughness_float32(r):
+    wi = np.array([0.5, 0.0, math.sqrt(0.75)], dtype=np.float32)
+    wo = np.array([-0.5, 0.0, math.sqrt(0.75)], dtype=np.float32)
+    m = bk.model("schlick", r=r, color=0.8)
+    f = m.eval(wi, wo)
+    assert f.dtype == np.float32
+    v = float(wi[2])
+    S = 0.8 + 0.2 * (1 - v) ** 5
+    np.testing.assert_allclose(f, [S / (math.pi * v * v)] * 3, rtol=1e-5)
+
+
+def test_double_slab_tiny_lower_roughness_is_finite():
+    """The issue's case: layers=double, color=1, r2=1e-170 gave NaN."""
+    m = bk.model("schlick", layers="double", color=1.0, r2=1e-170)
+    wi, wo = np.array([0.5, 0.0, math.sqrt(0.75)]), np.array([-0.5, 0.0, math.sqrt(0.75)])
+    f = m.eval(wi, wo)
+    assert np.isfinite(f).all() and (f >= 0).all()
+    top = bk.model("schlick", color=1.0).eval(wi, wo)
+    np.testing.assert_allclose(f, top, rtol=1e-12)  # (1 − S) = 0 at color = 1
+
+
+@pytest.mark.parametrize("p", [1e-30, 1e-200, TINY64])
+def test_tiny_isotropy_gives_one_over_sqrt_p_across_the_scratches(p):
+    """With h in the y-z plane (w = 0), A = sqrt(p/p²) = 1/sqrt(p): finite even where p² underflows."""
+    wi = np.array([0.0, math.sin(0.3), math.cos(0.3)])  # exactly in the y-z plane: w = 0
+    wo = np.array([0.0, math.sin(0.9), math.cos(0.9)])
+    ref = bk.model("schlick", r=0.3, p=1.0).eval(wi, wo)
+    f = bk.model("schlick", r=0.3, p=p).eval(wi, wo)
+    assert np.isfinite(f).all()
+    np.testing.assert_allclose(f, ref / math.sqrt(p), rtol=1e-12)
+
+
+# --- reinjection -----------------------------------------------------------------------------------
+@pytest.mark.parametrize("pair", PAIRS)
+@pytest.mark.parametrize("r,p", [(0.2, 0.4), (0.5, 1.0), (0.7, 0.9)])
+def test_reinjection_by_hand(pair, r, p):
+    """S·[a/π + b·(G G' Z A + 1 − G G')/(4π v v')], the reconstructed re-injection term."""
+    wi, wo = pair
+    C = np.array([0.9, 0.5, 0.1])
+    v, v2 = wi[2], wo[2]
+    G = lambda x: x / (r - r * x + x)  # noqa: E731
+    b = 4 * r * (1 - r)
+    extra = b * (1 - G(v) * G(v2)) / (4 * math.pi * v * v2)
+    expect = []
+    for c in C:
+        base, S = _slab_by_hand(wi, wo, c, r, p)
+        expect.append(base + S * extra)
+    m = bk.model("schlick", color=C, r=r, p=p, reinjection=True)
+    np.testing.assert_allclose(m.eval(wi, wo), expect, rtol=1e-11)
+
+
+def test_reinjection_off_by_default_and_zero_at_r_one():
+    wi, wo = random_upper(300, 61), random_upper(300, 62)
+    assert bk.model("schlick").params["reinjection"] is False
+    m1 = bk.model("schlick", r=1.0, color=0.4, reinjection=True)
+    np.testing.assert_allclose(m1.eval(wi, wo), bk.model("schlick", r=1.0, color=0.4).eval(wi, wo), rtol=1e-15)
+
+
+@pytest.mark.parametrize("layers", ["single", "double"])
+def test_reinjection_reciprocal(layers):
+    wi, wo = random_upper(2000, 63), random_upper(2000, 64)
+    m = bk.model("schlick", layers=layers, r=0.25, p=0.3, r2=0.6, reinjection=True)
+    np.testing.assert_allclose(m.eval(wi, wo), m.eval(wo, wi), rtol=1e-12)
+
+
+def test_reinjection_albedo_exceeds_one_at_grazing():
+    """Documented: the re-injected light alone grows like 1/(2v); with color = 1 the albedo passes 1."""
+    m = bk.model("schlick", color=1.0, r=0.5, reinjection=True)
+    a_normal = albedo(m, vec(0, 0))
+    a_grazing = albedo(m, vec(85, 0))
+    assert a_normal.max() < 1.0
+    assert a_grazing.min() > 2.0

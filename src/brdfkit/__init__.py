@@ -9,7 +9,8 @@ from __future__ import annotations
 
 from typing import Any
 
-from . import geometry, params, registry
+from . import engine, geometry, params, registry
+from .engine import set_engine
 
 # ``models`` is the package brdfkit.models, made callable: ``bk.models()`` lists the
 # registry names (SPEC) and ``import brdfkit.models.ward`` still works.
@@ -29,7 +30,7 @@ def model(name: str, **params: Any) -> BRDF:
     return registry.get(name)(**params)
 
 
-__all__ = ["BRDF", "models", "model_info", "model", "geometry", "params", "registry", "__version__"]
+__all__ = ["BRDF", "models", "model_info", "model", "geometry", "params", "registry", "engine", "set_engine", "__version__"]
 
 
 # -- measured data and fitting (brdfkit.measured; imported on first use) -------------

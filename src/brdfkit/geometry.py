@@ -14,9 +14,46 @@ Rusinkiewicz (1998) half/difference angles: with ``h = normalize(wi + wo)``,
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
+from .engine import jit
+
 _TINY = 1e-300
+
+
+# ------------------------------------------------ scalar forms for the kernels
+
+
+@jit
+def dot3(ax, ay, az, bx, by, bz):
+    """``a·b`` of two vectors given by components."""
+    return ax * bx + ay * by + az * bz
+
+
+@jit
+def scaled_sum_c(ix, iy, iz, ox, oy, oz):
+    """``(S_x, S_y, S_z, m)``: ``S = (wi + wo)/m`` with ``m`` the largest absolute component; scalar twin of :func:`scaled_sum`.
+
+    ``|S|`` lies in ``[1, √3]``, so normalising it neither underflows nor
+    overflows; ``S = +z``, ``m = 0`` where ``wi == −wo``.
+    """
+    sx = ix + ox
+    sy = iy + oy
+    sz = iz + oz
+    m = max(abs(sx), max(abs(sy), abs(sz)))
+    if m == 0.0:
+        return 0.0, 0.0, 1.0, 0.0
+    return sx / m, sy / m, sz / m, m
+
+
+@jit
+def half_vector_c(ix, iy, iz, ox, oy, oz):
+    """``normalize(wi + wo)`` in component form, robust at grazing angles: the scalar twin of :func:`half_vector`."""
+    sx, sy, sz, m = scaled_sum_c(ix, iy, iz, ox, oy, oz)
+    n = math.sqrt(sx * sx + sy * sy + sz * sz)
+    return sx / n, sy / n, sz / n
 
 
 def dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:

@@ -39,9 +39,12 @@ from __future__ import annotations
 import os
 from typing import Any
 
+import math
+
 import numpy as np
 
-from ..geometry import from_rusinkiewicz, half_vector
+from ..engine import jit, vectorize
+from ..geometry import from_rusinkiewicz, half_vector, half_vector_c
 from ..models.base import BRDF
 from ..params import Param
 
@@ -59,33 +62,63 @@ HALF_PI = np.pi / 2
 
 
 # --------------------------------------------------------------------------- indices
-def theta_h_index(theta_h) -> np.ndarray:
-    """MERL's θh bin: ``floor(sqrt(θh/(π/2)) · 90)``, 0 for θh ≤ 0, clamped to 89."""
-    th = np.asarray(theta_h, dtype=np.float64)
-    u = np.sqrt(np.maximum(th, 0.0) / HALF_PI) * RES_THETA_H
-    return np.clip(np.floor(u), 0, RES_THETA_H - 1).astype(np.intp)
+@jit
+def theta_h_bin(theta_h):
+    """MERL's θh bin: ``floor(sqrt(θh/(π/2)) · 90)``, 0 for θh ≤ 0, clamped to 89 (an int)."""
+    u = math.sqrt(max(theta_h, 0.0) / (0.5 * math.pi)) * RES_THETA_H
+    return int(min(max(math.floor(u), 0.0), RES_THETA_H - 1.0))
 
 
-def theta_d_index(theta_d) -> np.ndarray:
+@jit
+def theta_d_bin(theta_d):
     """MERL's θd bin: ``floor(θd/(π/2) · 90)`` clamped to [0, 89]."""
-    td = np.asarray(theta_d, dtype=np.float64)
-    return np.clip(np.floor(td / HALF_PI * RES_THETA_D), 0, RES_THETA_D - 1).astype(np.intp)
+    return int(min(max(math.floor(theta_d / (0.5 * math.pi) * RES_THETA_D), 0.0), RES_THETA_D - 1.0))
 
 
-def fold_phi_d(phi_d) -> np.ndarray:
+@jit
+def fold_phi(phi_d):
     """φd folded into [0, π) (reciprocity: φd and φd + π are the same configuration).
 
     Values within 1e-9 of π are snapped to 0, so that an in-plane pair and its
     swap (φd = 0 and φd = π up to rounding) fall into the same bin.
     """
-    pd = np.mod(np.asarray(phi_d, dtype=np.float64), np.pi)
-    return np.where(pd > np.pi - 1e-9, 0.0, pd)
+    pd = phi_d % math.pi
+    if pd > math.pi - 1e-9:
+        return 0.0
+    return pd
+
+
+@jit
+def phi_d_bin(phi_d):
+    """MERL's φd bin: ``floor(fold(φd)/π · 180)`` clamped to [0, 179]."""
+    return int(min(max(math.floor(fold_phi(phi_d) / math.pi * RES_PHI_D), 0.0), RES_PHI_D - 1.0))
+
+
+# array forms over the same scalar sources, compiled lazily on first use (nothing at import)
+_fold_v = vectorize(fold_phi, 1)
+_th_v = vectorize(theta_h_bin, 1)
+_td_v = vectorize(theta_d_bin, 1)
+_pd_v = vectorize(phi_d_bin, 1)
+
+
+def theta_h_index(theta_h) -> np.ndarray:
+    """Array form of :func:`theta_h_bin`."""
+    return _th_v(np.asarray(theta_h, dtype=np.float64)).astype(np.intp)
+
+
+def theta_d_index(theta_d) -> np.ndarray:
+    """Array form of :func:`theta_d_bin`."""
+    return _td_v(np.asarray(theta_d, dtype=np.float64)).astype(np.intp)
+
+
+def fold_phi_d(phi_d) -> np.ndarray:
+    """Array form of :func:`fold_phi`."""
+    return _fold_v(np.asarray(phi_d, dtype=np.float64))
 
 
 def phi_d_index(phi_d) -> np.ndarray:
-    """MERL's φd bin: ``floor(fold(φd)/π · 180)`` clamped to [0, 179]."""
-    pd = fold_phi_d(phi_d)
-    return np.clip(np.floor(pd / np.pi * RES_PHI_D), 0, RES_PHI_D - 1).astype(np.intp)
+    """Array form of :func:`phi_d_bin`."""
+    return _pd_v(np.asarray(phi_d, dtype=np.float64)).astype(np.intp)
 
 
 def bin_centres() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -100,30 +133,138 @@ def symmetric_half_diff(wi, wo) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``(θh, θd, φd folded into [0, π))``, bit-for-bit the same for ``(wi, wo)`` and ``(wo, wi)``.
 
     Mathematically the angles of :func:`brdfkit.geometry.to_rusinkiewicz` (φd
-    folded); computed symmetrically so that a pair and its swap always fall into
-    the same MERL bin, even on a bin boundary (a table is then exactly reciprocal).
+    folded); computed symmetrically (:func:`symmetric_half_diff_c`, the scalar source)
+    so that a pair and its swap always fall into the same MERL bin, even on a bin
+    boundary (a table is then exactly reciprocal).
     """
     wi = np.asarray(wi, dtype=np.float64)
     wo = np.asarray(wo, dtype=np.float64)
-    h = half_vector(wi, wo)  # built from wi + wo, which is symmetric in the pair
-    theta_h = np.arccos(np.clip(h[..., 2], -1.0, 1.0))
-    phi_h = np.arctan2(h[..., 1], h[..., 0])
-    ch, sh = np.cos(phi_h), np.sin(phi_h)
-    ct, st = np.cos(theta_h), np.sin(theta_h)
+    wi, wo = np.broadcast_arrays(wi, wo)
+    shape = wi.shape[:-1]
+    out = np.empty((3, int(np.prod(shape, dtype=np.int64))))
+    _half_diff_many(np.ascontiguousarray(wi).reshape(-1, 3), np.ascontiguousarray(wo).reshape(-1, 3), out)
+    return out[0].reshape(shape), out[1].reshape(shape), out[2].reshape(shape)
 
-    def to_h_frame(v):  # rotate by −φh about z, then by −θh about y
-        x = ch * v[..., 0] + sh * v[..., 1]
-        y = -sh * v[..., 0] + ch * v[..., 1]
-        z = v[..., 2]
-        return ct * x - st * z, y, st * x + ct * z
 
-    xi, yi, zi = to_h_frame(wi)
-    xo, yo, zo = to_h_frame(wo)
-    theta_d = np.arccos(np.clip(0.5 * (zi + zo), -1.0, 1.0))
-    vx, vy = xi - xo, yi - yo  # 2·(dx, dy); the swap negates it exactly
-    flip = (vy < 0) | ((vy == 0) & (vx < 0))
-    vx, vy = np.where(flip, -vx, vx), np.where(flip, -vy, vy)
-    return theta_h, theta_d, fold_phi_d(np.arctan2(vy, vx))
+@jit
+def symmetric_half_diff_c(ix, iy, iz, ox, oy, oz):
+    """The scalar form of :func:`symmetric_half_diff`: ``(θh, θd, φd folded)`` of one pair.
+
+    Built from ``wi + wo`` and the difference of the two directions in the half-vector
+    frame, so ``(wi, wo)`` and ``(wo, wi)`` give bit-identical angles.
+    """
+    hx, hy, hz = half_vector_c(ix, iy, iz, ox, oy, oz)
+    theta_h = math.acos(min(max(hz, -1.0), 1.0))
+    # cos/sin of φh and θh straight from h (no atan2/cos/sin round trip); φh = 0 at h = n
+    st = math.sqrt(hx * hx + hy * hy)
+    ct = hz
+    if st > 0.0:
+        ch = hx / st
+        sh = hy / st
+    else:
+        ch = 1.0
+        sh = 0.0
+    # rotate by −φh about z, then by −θh about y
+    xa = ch * ix + sh * iy
+    yi = -sh * ix + ch * iy
+    xi = ct * xa - st * iz
+    zi = st * xa + ct * iz
+    xb = ch * ox + sh * oy
+    yo = -sh * ox + ch * oy
+    xo = ct * xb - st * oz
+    zo = st * xb + ct * oz
+    theta_d = math.acos(min(max(0.5 * (zi + zo), -1.0), 1.0))
+    vx = xi - xo  # 2·(dx, dy); the swap negates it exactly
+    vy = yi - yo
+    if vy < 0.0 or (vy == 0.0 and vx < 0.0):
+        vx = -vx
+        vy = -vy
+    return theta_h, theta_d, fold_phi(math.atan2(vy, vx))
+
+
+@jit
+def merl_nearest(table, theta_h, theta_d, phi_d):
+    """MERL's lookup (its reader's bins) in a flat ``(3·90·90·180,)`` table, missing bins as 0."""
+    q = (theta_h_bin(theta_h) * RES_THETA_D + theta_d_bin(theta_d)) * RES_PHI_D + phi_d_bin(phi_d)
+    return max(table[q], 0.0), max(table[N_BINS + q], 0.0), max(table[2 * N_BINS + q], 0.0)
+
+
+@jit
+def merl_trilinear(table, theta_h, theta_d, phi_d):
+    """Trilinear interpolation in index space over the measured corners (0 where none is).
+
+    Samples sit at their bin centres in index space: θh and θd clamped at the ends, φd
+    periodic with period π; a corner counts only where all three channels were measured.
+    """
+    ch = min(max(math.sqrt(max(theta_h, 0.0) / (0.5 * math.pi)) * RES_THETA_H - 0.5, 0.0), RES_THETA_H - 1.0)
+    cd = min(max(theta_d / (0.5 * math.pi) * RES_THETA_D - 0.5, 0.0), RES_THETA_D - 1.0)
+    cp = fold_phi(phi_d) / math.pi * RES_PHI_D - 0.5
+    i0 = min(int(math.floor(ch)), RES_THETA_H - 2)
+    j0 = min(int(math.floor(cd)), RES_THETA_D - 2)
+    k0f = math.floor(cp)
+    fh = ch - i0
+    fd = cd - j0
+    fp = cp - k0f
+    k0 = int(k0f) % RES_PHI_D
+    k1 = (k0 + 1) % RES_PHI_D
+    a0 = 0.0
+    a1 = 0.0
+    a2 = 0.0
+    wsum = 0.0
+    for di in range(2):
+        wi_ = fh if di == 1 else 1.0 - fh
+        for dj in range(2):
+            wj_ = fd if dj == 1 else 1.0 - fd
+            for dk in range(2):
+                wk_ = fp if dk == 1 else 1.0 - fp
+                kk = k1 if dk == 1 else k0
+                q = ((i0 + di) * RES_THETA_D + (j0 + dj)) * RES_PHI_D + kk
+                v0 = table[q]
+                v1 = table[N_BINS + q]
+                v2 = table[2 * N_BINS + q]
+                if v0 >= 0.0 and v1 >= 0.0 and v2 >= 0.0:
+                    w = wi_ * wj_ * wk_
+                    a0 += w * v0
+                    a1 += w * v1
+                    a2 += w * v2
+                    wsum += w
+    if wsum > 1e-12:
+        return a0 / wsum, a1 / wsum, a2 / wsum
+    return 0.0, 0.0, 0.0
+
+
+@jit
+def merl_kernel(wix, wiy, wiz, wox, woy, woz, p, c):
+    """A MERL table per pair (engine protocol, :mod:`brdfkit.engine`).
+
+    ``p`` = the flat ``(3, 90, 90, 180)`` table in 1/sr (negative = missing); ``c`` = [interpolation
+    (0 nearest, 1 trilinear)].
+    """
+    th, td, pd = symmetric_half_diff_c(wix, wiy, wiz, wox, woy, woz)
+    if c[0] == 1:
+        return merl_trilinear(p, th, td, pd)
+    return merl_nearest(p, th, td, pd)
+
+
+@jit
+def _half_diff_many(wi, wo, out):
+    for j in range(wi.shape[0]):
+        a, b, c = symmetric_half_diff_c(wi[j, 0], wi[j, 1], wi[j, 2], wo[j, 0], wo[j, 1], wo[j, 2])
+        out[0, j] = a
+        out[1, j] = b
+        out[2, j] = c
+
+
+@jit
+def _lookup_many(table, th, td, pd, trilinear, out):
+    for j in range(th.shape[0]):
+        if trilinear:
+            r, g, b = merl_trilinear(table, th[j], td[j], pd[j])
+        else:
+            r, g, b = merl_nearest(table, th[j], td[j], pd[j])
+        out[j, 0] = r
+        out[j, 1] = g
+        out[j, 2] = b
 
 
 # --------------------------------------------------------------------------- the model
@@ -190,6 +331,15 @@ class MERLBRDF(MeasuredBRDF):
         return f"<MERLBRDF {self.label!r} interpolation={self.params['interpolation']!r}>"
 
     # -- lookup ------------------------------------------------------------------
+    kernel = staticmethod(merl_kernel)
+
+    def kernel_args(self):
+        key = "_kernel_args"
+        if key not in self._cache:
+            c = np.array([self.spec[0].choices.index(self.params["interpolation"])], dtype=np.int64)
+            self._cache[key] = (np.ascontiguousarray(self.table, dtype=np.float64).reshape(-1), c)
+        return self._cache[key]
+
     def lookup_nearest(self, theta_h, theta_d, phi_d) -> np.ndarray:
         """MERL's lookup: values of the bins (negative where missing), shape ``(..., 3)``."""
         i = theta_h_index(theta_h)
@@ -197,37 +347,20 @@ class MERLBRDF(MeasuredBRDF):
         k = phi_d_index(phi_d)
         return np.moveaxis(self.table[:, i, j, k], 0, -1)
 
+    def _lookup(self, theta_h, theta_d, phi_d, trilinear: bool) -> np.ndarray:
+        th, td, pd = np.broadcast_arrays(*(np.asarray(x, dtype=np.float64) for x in (theta_h, theta_d, phi_d)))
+        shape = th.shape
+        out = np.empty((th.size, 3))
+        flat = self.kernel_args()[0]
+        _lookup_many(flat, th.ravel().copy(), td.ravel().copy(), pd.ravel().copy(), trilinear, out)
+        return out.reshape(shape + (3,))
+
     def lookup_trilinear(self, theta_h, theta_d, phi_d) -> np.ndarray:
-        """Trilinear interpolation in index space over measured corners (0 where none is)."""
-        th = np.asarray(theta_h, dtype=np.float64)
-        td = np.asarray(theta_d, dtype=np.float64)
-        th, td, pd = np.broadcast_arrays(th, td, fold_phi_d(phi_d))
-        ch = np.clip(np.sqrt(np.maximum(th, 0.0) / HALF_PI) * RES_THETA_H - 0.5, 0, RES_THETA_H - 1)
-        cd = np.clip(td / HALF_PI * RES_THETA_D - 0.5, 0, RES_THETA_D - 1)
-        cp = pd / np.pi * RES_PHI_D - 0.5  # periodic
-        i0 = np.minimum(np.floor(ch).astype(np.intp), RES_THETA_H - 2)
-        j0 = np.minimum(np.floor(cd).astype(np.intp), RES_THETA_D - 2)
-        k0f = np.floor(cp)
-        fh, fd, fp = ch - i0, cd - j0, cp - k0f
-        k0 = np.mod(k0f.astype(np.intp), RES_PHI_D)
-        k1 = np.mod(k0 + 1, RES_PHI_D)
-        acc = np.zeros(th.shape + (3,))
-        wsum = np.zeros(th.shape)
-        for di, wi_ in ((0, 1 - fh), (1, fh)):
-            for dj, wj_ in ((0, 1 - fd), (1, fd)):
-                for kk, wk_ in ((k0, 1 - fp), (k1, fp)):
-                    w = wi_ * wj_ * wk_
-                    v = np.moveaxis(self.table[:, i0 + di, j0 + dj, kk], 0, -1)
-                    ok = (v >= 0).all(axis=-1)
-                    w = np.where(ok, w, 0.0)
-                    acc += w[..., None] * np.where(ok[..., None], v, 0.0)
-                    wsum += w
-        return np.where(wsum[..., None] > 1e-12, acc / np.where(wsum > 1e-12, wsum, 1.0)[..., None], 0.0)
+        """Trilinear interpolation in index space over measured corners (0 where none is), :func:`merl_trilinear`."""
+        return self._lookup(theta_h, theta_d, phi_d, True)
 
     def eval_rusinkiewicz(self, theta_h, theta_d, phi_d) -> np.ndarray:
-        if self.params["interpolation"] == "trilinear":
-            return self.lookup_trilinear(theta_h, theta_d, phi_d)
-        return np.maximum(self.lookup_nearest(theta_h, theta_d, phi_d), 0.0)
+        return self._lookup(theta_h, theta_d, phi_d, self.params["interpolation"] == "trilinear")
 
 
 # --------------------------------------------------------------------------- tabulation

@@ -15,7 +15,9 @@ Each network maps the Rusinkiewicz half/difference vectors (φh = 0)
 
 through ``relu(x·W1 + b1)`` (21 units), ``relu(·W2 + b2)`` (21 units) and
 ``max(exp(·W3 + b3) − 1, 0)`` to RGB f_r in 1/sr (MERL's channel scales
-already applied). The difference vector is the light direction ``wi`` seen from
+already applied). The network is evaluated per pair in float64 by the scalar
+kernel :func:`nbrdf_kernel` (weights stored as float32, as published; the
+argument of exp is capped at 80, never reached by real data). The difference vector is the light direction ``wi`` seen from
 the half-vector frame, as :func:`brdfkit.geometry.to_rusinkiewicz` computes it.
 """
 
@@ -23,11 +25,13 @@ from __future__ import annotations
 
 import difflib
 import functools
+import math
 import os
 
 import numpy as np
 
-from .merl import MeasuredBRDF, fold_phi_d
+from ..engine import jit
+from .merl import MeasuredBRDF, symmetric_half_diff_c
 
 _DATA = os.path.join(os.path.dirname(__file__), "data", "nbrdf_weights.npz")
 SETS = ("merl", "rgl", "nielsen")
@@ -66,6 +70,71 @@ def resolve(name: str) -> str:
     )
 
 
+#: the layer sizes: 6 inputs, two hidden layers of 21, 3 outputs
+N_IN, N_HID, N_OUT = 6, 21, 3
+#: offsets of W1 (6×21, row-major), b1, W2 (21×21), b2, W3 (21×3), b3 in the flat weight vector
+_O_W1 = 0
+_O_B1 = _O_W1 + N_IN * N_HID
+_O_W2 = _O_B1 + N_HID
+_O_B2 = _O_W2 + N_HID * N_HID
+_O_W3 = _O_B2 + N_HID
+_O_B3 = _O_W3 + N_HID * N_OUT
+N_WEIGHTS = _O_B3 + N_OUT
+
+
+@jit
+def nbrdf_network(w, theta_h, theta_d, phi_d):
+    """The Neural-BRDF network at one configuration (φh = 0): RGB f_r in 1/sr.
+
+    ``x = (sin θh, 0, cos θh, sin θd cos φd, sin θd sin φd, cos θd)``,
+    ``a1 = relu(x·W1 + b1)``, ``a2 = relu(a1·W2 + b2)``, ``f = max(exp(a2·W3 + b3) − 1, 0)``.
+    ``w`` is the flat weight vector (offsets ``_O_*``).
+    """
+    sd = math.sin(theta_d)
+    x0 = math.sin(theta_h)
+    x2 = math.cos(theta_h)
+    x3 = sd * math.cos(phi_d)
+    x4 = sd * math.sin(phi_d)
+    x5 = math.cos(theta_d)
+    a1 = np.empty(N_HID)
+    for u in range(N_HID):  # x1 = 0 contributes nothing
+        z = (w[_O_B1 + u] + x0 * w[_O_W1 + u] + x2 * w[_O_W1 + 2 * N_HID + u] + x3 * w[_O_W1 + 3 * N_HID + u]
+             + x4 * w[_O_W1 + 4 * N_HID + u] + x5 * w[_O_W1 + 5 * N_HID + u])
+        a1[u] = max(z, 0.0)
+    o0 = w[_O_B3]
+    o1 = w[_O_B3 + 1]
+    o2 = w[_O_B3 + 2]
+    for u in range(N_HID):
+        z = w[_O_B2 + u]
+        for t in range(N_HID):
+            z += a1[t] * w[_O_W2 + t * N_HID + u]
+        if z > 0.0:
+            o0 += z * w[_O_W3 + u * N_OUT]
+            o1 += z * w[_O_W3 + u * N_OUT + 1]
+            o2 += z * w[_O_W3 + u * N_OUT + 2]
+    return (max(math.expm1(min(o0, 80.0)), 0.0), max(math.expm1(min(o1, 80.0)), 0.0),
+            max(math.expm1(min(o2, 80.0)), 0.0))
+
+
+@jit
+def nbrdf_kernel(wix, wiy, wiz, wox, woy, woz, p, c):
+    """A Neural-BRDF material per pair (engine protocol, :mod:`brdfkit.engine`); φd folded into [0, π).
+
+    ``p`` = the flat weights (:data:`N_WEIGHTS` floats, offsets ``_O_*``); ``c`` unused.
+    """
+    th, td, pd = symmetric_half_diff_c(wix, wiy, wiz, wox, woy, woz)
+    return nbrdf_network(p, th, td, pd)
+
+
+@jit
+def _network_many(w, th, td, pd, out):
+    for j in range(th.shape[0]):
+        r, g, b = nbrdf_network(w, th[j], td[j], pd[j])
+        out[j, 0] = r
+        out[j, 1] = g
+        out[j, 2] = b
+
+
 class NeuralBRDF(MeasuredBRDF):
     """One measured material as its Neural-BRDF network (a model with no parameters).
 
@@ -92,33 +161,30 @@ class NeuralBRDF(MeasuredBRDF):
         self.material = full
         self.label = full
         self._layers = tuple(w[f"{full}/{k}"] for k in ("fc1", "b1", "fc2", "b2", "fc3", "b3"))
+        shapes = ((N_IN, N_HID), (N_HID,), (N_HID, N_HID), (N_HID,), (N_HID, N_OUT), (N_OUT,))
+        if tuple(a.shape for a in self._layers) != shapes:
+            raise ValueError(f"{full}: unexpected network shape {[a.shape for a in self._layers]}")
+        self._flat = np.ascontiguousarray(np.concatenate([a.astype(np.float64).ravel() for a in self._layers]))
         super().__init__()
 
     def __repr__(self) -> str:
         return f"bk.material({self.material!r})"
 
+    kernel = staticmethod(nbrdf_kernel)
+
+    def kernel_args(self):
+        return self._flat, np.zeros(1, dtype=np.int64)
+
     def eval_rusinkiewicz(self, theta_h, theta_d, phi_d) -> np.ndarray:
+        """The network at Rusinkiewicz angles (φd folded into [0, π)), ``(..., 3)`` float64."""
+        from .merl import fold_phi_d
+
         th, td, pd = np.broadcast_arrays(
             np.asarray(theta_h, np.float64), np.asarray(theta_d, np.float64), np.asarray(phi_d, np.float64)
         )
         shape = th.shape
-        th, td, pd = th.ravel(), td.ravel(), fold_phi_d(pd.ravel())
-        sd = np.sin(td)
-        x = np.empty((th.size, 6), dtype=np.float32)
-        x[:, 0] = np.sin(th)
-        x[:, 1] = 0.0
-        x[:, 2] = np.cos(th)
-        x[:, 3] = sd * np.cos(pd)
-        x[:, 4] = sd * np.sin(pd)
-        x[:, 5] = np.cos(td)
-        w1, b1, w2, b2, w3, b3 = self._layers
-        out = np.empty((th.size, 3), dtype=np.float64)
-        step = 1 << 16
-        for s in range(0, th.size, step):
-            a = np.maximum(x[s : s + step] @ w1 + b1, 0.0)
-            a = np.maximum(a @ w2 + b2, 0.0)
-            z = np.minimum(a @ w3 + b3, 80.0)  # exp overflow guard (never reached by real data)
-            out[s : s + step] = np.maximum(np.expm1(z.astype(np.float64)), 0.0)
+        out = np.empty((th.size, 3))
+        _network_many(self._flat, th.ravel().copy(), td.ravel().copy(), fold_phi_d(pd.ravel()), out)
         return out.reshape(shape + (3,))
 
 

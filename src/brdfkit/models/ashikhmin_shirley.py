@@ -49,40 +49,109 @@ Numerics: h·k and max(n·wi, n·wo) are clamped to a floor of 1e-6 in the
 denominator (they vanish only when both directions are within 0.00006° of
 the horizon), which keeps every value finite.
 
+Variant ``"ngan"`` (Ngan, Durand & Matusik, "Experimental Analysis of BRDF
+Models", EGSR 2005, the form their fits to the MERL data use): the diffuse term
+is decoupled — a plain Lambert ``kd/π`` — and the specular lobe gets its own RGB
+weight ``ks`` and its own Schlick Fresnel reflectance ``f0``::
+
+    f_r = kd/π + ks · sqrt((nu+1)(nv+1))/(8π) · (n·h)^(nu cos²φh + nv sin²φh)
+                     / ((h·k) · max(n·wi, n·wo)) · F(h·k),   F(c) = f0 + (1 − f0)(1 − c)⁵
+
+(``rd`` and ``rs`` are not used there; ``kd``, ``ks`` and ``f0`` are not used by
+``"paper"``). Both variants share the lobe function below; ``"paper"`` is
+``"ngan"`` with ks = 1, f0 = R_s and the coupled ρ_d in place of kd/π.
+
 =========  ======  =======  ============  =============================================
 parameter  kind    default  range         meaning
 =========  ======  =======  ============  =============================================
-rd         rgb     0.5      [0, 1]        diffuse reflectance R_d
-rs         rgb     0.05     [0, 1]        specular reflectance at normal incidence R_s
+variant    choice  paper    paper | ngan  the paper's coupled form, or Ngan et al.'s
+rd         rgb     0.5      [0, 1]        diffuse reflectance R_d (paper)
+rs         rgb     0.05     [0, 1]        specular reflectance at normal incidence R_s (paper)
 nu         scalar  100      [0, 1e5]      Phong exponent along the tangent +x
 nv         scalar  100      [0, 1e5]      Phong exponent along the bitangent +y
+kd         rgb     0.5      [0, 1]        Lambert diffuse albedo (ngan)
+ks         rgb     1        [0, 10]       weight of the specular lobe (ngan)
+f0         rgb     0.05     [0, 1]        Schlick reflectance at normal incidence (ngan)
 =========  ======  =======  ============  =============================================
 """
 
 from __future__ import annotations
 
-import numpy as np
+import math
 
-from ..geometry import half_vector
+from ..engine import jit
+from ..geometry import dot3, half_vector_c
 from ..params import Param, exponent_param
 from ..registry import register
-from ..terms.fresnel import fresnel_schlick
+from ..terms.fresnel import f_schlick
 from .base import BRDF
 
 #: floor on h·k and max(n·wi, n·wo) in the specular denominator
 COS_FLOOR = 1e-6
 
 
+@jit
 def anisotropic_cos_power(hx, hy, hz, nu, nv):
-    """``(n·h)^((nu hx² + nv hy²)/(hx² + hy²))`` for a unit h, stable at h = n and for huge exponents."""
+    """``(n·h)^((nu hx² + nv hy²)/(hx² + hy²))`` for a unit h, stable at h = n and for huge exponents.
+
+    As ``exp(½ (nu hx² + nv hy²) · log(1 − s²)/s²)``, s² = hx² + hy², with log1p where s² is
+    small (no cancellation) and 2 log(hz) otherwise; ``log(1 − s²)/s² → −1`` at h = n.
+    """
     s2 = hx * hx + hy * hy
     t = nu * hx * hx + nv * hy * hy
-    one = np.ones_like(s2)
-    # log(1 - s²)/s²: log1p where s² is small (no cancellation), 2 log(hz) otherwise
-    small = s2 < 0.5
-    lg = np.where(small, np.log1p(-np.where(small, s2, 0)), 2 * np.log(np.where(small, one, hz)))
-    q = np.where(s2 > 0, lg / np.where(s2 > 0, s2, 1), -1)
-    return np.where(t > 0, np.exp(0.5 * q * t), 1)
+    if t <= 0.0:
+        return 1.0
+    if s2 < 0.5:
+        lg = math.log1p(-s2)
+    elif hz > 0.0:
+        lg = 2.0 * math.log(hz)
+    else:
+        return 0.0  # h in the tangent plane: (n·h)^e = 0 for e > 0
+    q = lg / s2 if s2 > 0.0 else -1.0
+    return math.exp(0.5 * q * t)
+
+
+@jit
+def specular_lobe(hx, hy, hz, hk, ci, co, nu, nv):
+    """``sqrt((nu+1)(nv+1))/(8π) · (n·h)^(nu cos²φh + nv sin²φh) / ((h·k) · max(n·wi, n·wo))``
+    (A&S 2000's ρ_s without its Fresnel factor), the floors of :data:`COS_FLOOR` in the denominator."""
+    lobe = anisotropic_cos_power(hx, hy, hz, nu, nv)
+    denom = max(hk, COS_FLOOR) * max(max(ci, co), COS_FLOOR)
+    return math.sqrt((nu + 1.0) * (nv + 1.0)) / (8.0 * math.pi) * lobe / denom
+
+
+@jit
+def one_minus_pow5(x):
+    """``1 − (1 − x)⁵ = x (5 − 10x + 10x² − 5x³ + x⁴)``, without the cancellation at small x (grazing)."""
+    return x * (5.0 + x * (-10.0 + x * (10.0 + x * (-5.0 + x))))
+
+
+@jit
+def coupled_diffuse(rd, rs, ci, co):
+    """A&S 2000's ρ_d = 28 Rd/(23π) (1 − Rs)(1 − (1 − n·wi/2)⁵)(1 − (1 − n·wo/2)⁵), one channel."""
+    return 28.0 / (23.0 * math.pi) * rd * (1.0 - rs) * one_minus_pow5(0.5 * ci) * one_minus_pow5(0.5 * co)
+
+
+@jit
+def ashikhmin_shirley_kernel(wix, wiy, wiz, wox, woy, woz, p, c):
+    """Ashikhmin-Shirley per pair (engine protocol, :mod:`brdfkit.engine`).
+
+    ``p`` = [rd (3), rs (3), nu, nv, kd (3), ks (3), f0 (3)]; ``c`` = [variant (0 paper, 1 ngan)].
+    """
+    hx, hy, hz = half_vector_c(wix, wiy, wiz, wox, woy, woz)
+    hk = min(max(dot3(wix, wiy, wiz, hx, hy, hz), 0.0), 1.0)
+    spec = specular_lobe(hx, hy, hz, hk, wiz, woz, p[6], p[7])
+    if c[0] == 1:  # Ngan et al. 2005: kd/π + ks·lobe·F(f0)
+        return (
+            p[8] / math.pi + p[11] * spec * f_schlick(p[14], hk),
+            p[9] / math.pi + p[12] * spec * f_schlick(p[15], hk),
+            p[10] / math.pi + p[13] * spec * f_schlick(p[16], hk),
+        )
+    return (
+        coupled_diffuse(p[0], p[3], wiz, woz) + spec * f_schlick(p[3], hk),
+        coupled_diffuse(p[1], p[4], wiz, woz) + spec * f_schlick(p[4], hk),
+        coupled_diffuse(p[2], p[5], wiz, woz) + spec * f_schlick(p[5], hk),
+    )
 
 
 @register
@@ -92,27 +161,31 @@ class AshikhminShirley(BRDF):
     reference = "Ashikhmin and Shirley, An Anisotropic Phong BRDF Model, JGT 5(2), 2000"
     isotropic = False
     spec = (
+        Param(
+            "variant",
+            "choice",
+            "paper",
+            doc="paper: coupled R_d/R_s (Ashikhmin & Shirley 2000); ngan: Lambert kd + ks·lobe with "
+            "Schlick f0 (Ngan, Durand & Matusik 2005)",
+            choices=("paper", "ngan"),
+            fit=False,
+        ),
         Param("rd", "rgb", 0.5, (0.0, 1.0), "", "diffuse reflectance R_d"),
         Param("rs", "rgb", 0.05, (0.0, 1.0), "", "specular reflectance at normal incidence R_s (Schlick F0)"),
         exponent_param("nu", 100.0, "Phong exponent along the tangent +x (smaller = wider highlight in x)"),
         exponent_param("nv", 100.0, "Phong exponent along the bitangent +y"),
+        Param("kd", "rgb", 0.5, (0.0, 1.0), "", "Lambert diffuse albedo kd (variant=ngan only)"),
+        Param("ks", "rgb", 1.0, (0.0, 10.0), "", "weight of the specular lobe (variant=ngan only)",
+              fit_range=(0.0, 5.0)),
+        Param("f0", "rgb", 0.05, (0.0, 1.0), "", "Schlick reflectance at normal incidence (variant=ngan only)"),
     )
 
-    def _eval(self, wi, wo, p):
-        dt = wi.dtype.type
-        pi = dt(np.pi)
-        rd, rs = p["rd"], p["rs"]
-        nu, nv = p["nu"], p["nv"]
-        h = half_vector(wi, wo)
-        hx, hy, hz = h[..., 0], h[..., 1], h[..., 2]
-        hk = np.clip(np.einsum("...i,...i->...", wi, np.stack([hx, hy, hz], axis=-1)), dt(0), dt(1))
-        ci, co = wi[..., 2], wo[..., 2]
-        lobe = anisotropic_cos_power(hx, hy, hz, nu, nv)
-        floor = dt(COS_FLOOR)
-        denom = np.maximum(hk, floor) * np.maximum(np.maximum(ci, co), floor)
-        k = np.sqrt((nu + dt(1)) * (nv + dt(1))) / (dt(8) * pi)
-        spec = (k * lobe / denom)[..., None] * fresnel_schlick(rs, hk[..., None])
-        a = dt(1) - (dt(1) - ci * dt(0.5)) ** 5
-        b = dt(1) - (dt(1) - co * dt(0.5)) ** 5
-        diff = (dt(28) / (dt(23) * pi)) * rd * (dt(1) - rs) * (a * b)[..., None]
-        return diff + spec
+    def active_params(self) -> dict:
+        """``params`` less the other variant's parameters."""
+        unused = ("kd", "ks", "f0") if self.params["variant"] == "paper" else ("rd", "rs")
+        return {k: v for k, v in self.params.items() if k not in unused}
+
+    kernel = staticmethod(ashikhmin_shirley_kernel)
+
+    def kernel_args(self):
+        return self._pack(("rd", "rs", "nu", "nv", "kd", "ks", "f0"), ("variant",))

@@ -8,11 +8,14 @@ A model subclass declares, as class attributes:
 ``isotropic``  whether the model depends on the azimuth only through φi − φo
 ``spec``       tuple of :class:`brdfkit.params.Param`, the single parameter source
 
-and implements ``_eval(wi, wo, p)`` for directions that are already known to
-lie strictly above the horizon (``wi.z > 0`` and ``wo.z > 0``). ``p`` holds the
-parameters converted to the working dtype (rgb parameters as ``(3,)`` arrays).
-:meth:`BRDF.eval` does the rest of the contract: broadcasting, dtype,
-the zero below the horizon.
+and implements EITHER a compiled scalar kernel (``kernel`` and
+``kernel_args()``, the protocol of :mod:`brdfkit.engine`, which every built-in
+analytic model uses) OR, the fallback, ``_eval(wi, wo, p)`` in numpy for
+directions that are already known to lie strictly above the horizon
+(``wi.z > 0`` and ``wo.z > 0``); ``p`` holds the parameters converted to the
+working dtype (rgb parameters as ``(3,)`` arrays). :meth:`BRDF.eval` does the
+rest of the contract: broadcasting, dtype, the unit-direction check, the zero
+below the horizon.
 """
 
 from __future__ import annotations
@@ -32,6 +35,8 @@ class BRDF:
     reference: ClassVar[str] = ""
     isotropic: ClassVar[bool] = True
     spec: ClassVar[tuple[Param, ...]] = ()
+    #: the compiled scalar kernel (protocol: :mod:`brdfkit.engine`); None: ``_eval`` is used
+    kernel: ClassVar[Any] = None
 
     def __init__(self, **params: Any) -> None:
         self.params: dict[str, Any] = validate(self.name, self.spec, params)
@@ -45,30 +50,45 @@ class BRDF:
     def eval(self, wi, wo) -> np.ndarray:
         """f_r(wi, wo), shape ``broadcast(wi, wo)``; zero where ``wi.z <= 0`` or ``wo.z <= 0``.
 
-        float32 inputs (both) give a float32 result computed in float32.
+        float32 inputs (both) give a float32 result. ``wi`` and ``wo`` must be unit
+        vectors (within 1e-4, float32 1e-3); others raise ``ValueError``. Runs the
+        model's compiled kernel, the same kernel uncompiled under
+        ``bk.set_engine("reference")``, or ``_eval`` for a model without a kernel
+        (see :mod:`brdfkit.engine`).
         """
-        wi = np.asarray(wi)
-        wo = np.asarray(wo)
-        if wi.shape[-1:] != (3,) or wo.shape[-1:] != (3,):
-            raise ValueError(f"{self.name}: directions must have a last axis of length 3, got {wi.shape} and {wo.shape}")
-        dtype = np.float32 if (wi.dtype == np.float32 and wo.dtype == np.float32) else np.float64
-        wi = wi.astype(dtype, copy=False)
-        wo = wo.astype(dtype, copy=False)
-        wi, wo = np.broadcast_arrays(wi, wo)
-        valid = (wi[..., 2] > 0) & (wo[..., 2] > 0)
-        all_valid = bool(valid.all())
-        if not all_valid:
-            up = np.zeros(3, dtype=dtype)
-            up[2] = 1
-            wi = np.where(valid[..., None], wi, up)
-            wo = np.where(valid[..., None], wo, up)
-        p = self._typed_params(dtype)
-        with np.errstate(all="ignore"):
-            f = self._eval(wi, wo, p)
-        f = np.broadcast_to(np.asarray(f, dtype=dtype), wi.shape)
-        if not all_valid:
-            f = np.where(valid[..., None], f, dtype(0))
-        return np.ascontiguousarray(f)
+        from ..engine import evaluate
+
+        return evaluate(self, wi, wo)
+
+    def kernel_args(self):
+        """``(p, c)`` for :attr:`kernel`: float64 numeric and int64 choice arrays (see :mod:`brdfkit.engine`).
+
+        Returning ``None`` makes this instance use ``_eval`` instead (for an option
+        the kernel does not implement yet).
+        """
+        raise NotImplementedError(f"{self.name}: a model with a kernel must implement kernel_args()")
+
+    def _pack(self, numeric: tuple[str, ...], choices: tuple[str, ...] = ()):
+        """``(p, c)`` from parameter names: rgb as 3 floats, scalars as 1, choices as their index, bools 0/1.
+
+        Cached per instance (parameters never change after construction).
+        """
+        key = ("_pack", numeric, choices)
+        hit = self._cache.get(key)
+        if hit is None:
+            by_name = {q.name: q for q in self.spec}
+            vals = []
+            for n in numeric:
+                vals.extend(np.ravel(np.asarray(self.params[n], dtype=np.float64)).tolist())
+            ints = []
+            for n in choices:
+                v = self.params[n]
+                q = by_name[n]
+                ints.append(q.choices.index(v) if q.choices else int(bool(v)))
+            p = np.ascontiguousarray(vals, dtype=np.float64)
+            c = np.ascontiguousarray(ints if ints else [0], dtype=np.int64)
+            hit = self._cache[key] = (p, c)
+        return hit
 
     def _eval(self, wi: np.ndarray, wo: np.ndarray, p: dict[str, Any]) -> np.ndarray:  # pragma: no cover
         raise NotImplementedError

@@ -52,12 +52,26 @@ normalized  bool    true     true | false  (s+8)/(8π) form, else the raw OpenGL
 
 from __future__ import annotations
 
-import numpy as np
+import math
 
-from ..geometry import half_vector
+from ..engine import jit
+from ..geometry import half_vector_c
 from ..registry import register
 from .base import BRDF
-from .phong import phong_family_combine, phong_family_spec
+from .phong import phong_family_lobe, phong_family_spec
+
+
+@jit
+def blinn_phong_kernel(wix, wiy, wiz, wox, woy, woz, p, c):
+    """kd/π + ks·lobe, lobe = (n·h)^s, (s+8)/(8π)-normalised or raw/(n·wi).
+
+    ``p = [kd(3), ks(3), shininess]``, ``c = [normalized]``.
+    """
+    hx, hy, hz = half_vector_c(wix, wiy, wiz, wox, woy, woz)
+    nh = min(max(hz, 0.0), 1.0)
+    s = p[6]
+    lobe = phong_family_lobe(nh ** s, wiz, c[0], (s + 8.0) / (8.0 * math.pi))
+    return p[0] / math.pi + p[3] * lobe, p[1] / math.pi + p[4] * lobe, p[2] / math.pi + p[5] * lobe
 
 
 @register
@@ -76,8 +90,7 @@ class BlinnPhong(BRDF):
         "false: OpenGL's (n·h)^s divided by cos θi (neither reciprocal nor energy conserving)",
     )
 
-    def _eval(self, wi, wo, p):
-        dt = wi.dtype.type
-        nh = np.clip(half_vector(wi, wo)[..., 2], dt(0), dt(1))
-        s = p["shininess"]
-        return phong_family_combine(np.power(nh, s), wi, p, (s + dt(8)) / dt(8 * np.pi))
+    kernel = staticmethod(blinn_phong_kernel)
+
+    def kernel_args(self):
+        return self._pack(("kd", "ks", "shininess"), ("normalized",))

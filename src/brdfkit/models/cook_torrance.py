@@ -43,17 +43,40 @@ lobe would be narrower than float32 resolves near the normal).
 
 from __future__ import annotations
 
-import numpy as np
+import math
 
-from ..geometry import half_vector
+from ..engine import jit
+from ..geometry import half_vector_c
 from ..params import Param, kd_param, ks_param
 from ..registry import register
-from ..terms.distributions import beckmann
-from ..terms.fresnel import fresnel_dielectric_cook
-from ..terms.shadowing import v_groove
+from ..terms.distributions import d_beckmann_slopes
+from ..terms.fresnel import f_dielectric
+from ..terms.shadowing import g_vgroove
 from .base import BRDF
 
-_COS_FLOOR = {np.dtype(np.float32): 1e-18, np.dtype(np.float64): 1e-150}
+#: floor on n·l and n·v in the 1/((n·l)(n·v)) factor (kernels compute in float64)
+COS_FLOOR = 1e-150
+
+
+@jit
+def cook_torrance_kernel(wix, wiy, wiz, wox, woy, woz, p, c):
+    """kd/π + ks·(F/π)·D·G/((n·l)(n·v)) (Cook & Torrance 1982), per RGB channel.
+
+    D = exp(−tan²α/m²)/(m² cos⁴α) (no 1/π), F exact dielectric at c = v·h, G V-groove.
+    ``p = [kd(3), ks(3), m, ior(3)]``, ``c`` unused.
+    """
+    hx, hy, hz = half_vector_c(wix, wiy, wiz, wox, woy, woz)
+    l_h = wix * hx + wiy * hy + wiz * hz
+    v_h = wox * hx + woy * hy + woz * hz
+    cc = min(max(0.5 * (l_h + v_h), 0.0), 1.0)  # = v·h = l·h, symmetric
+    m = p[6]
+    D = d_beckmann_slopes(hx, hy, hz, m, m)
+    G = g_vgroove(hz, woz, wiz, v_h, l_h)
+    geo = G / (max(wiz, COS_FLOOR) * max(woz, COS_FLOOR))
+    sr = (p[3] * (f_dielectric(cc, p[7]) / math.pi) * D) * geo
+    sg = (p[4] * (f_dielectric(cc, p[8]) / math.pi) * D) * geo
+    sb = (p[5] * (f_dielectric(cc, p[9]) / math.pi) * D) * geo
+    return sr + p[0] / math.pi, sg + p[1] / math.pi, sb + p[2] / math.pi
 
 
 @register
@@ -71,25 +94,10 @@ class CookTorrance(BRDF):
               log_scale=True, fit_range=(1.0, 200.0)),
     )
 
-    def _eval(self, wi, wo, p):
-        dt = wi.dtype
-        floor = dt.type(_COS_FLOOR[dt])
-        h = half_vector(wi, wo)
-        n_l = wi[..., 2]
-        n_v = wo[..., 2]
-        n_h = h[..., 2]
-        l_h = np.einsum("...i,...i->...", wi, h)
-        v_h = np.einsum("...i,...i->...", wo, h)
-        c = np.clip(dt.type(0.5) * (l_h + v_h), dt.type(0), dt.type(1))  # = v·h = l·h, symmetric
+    kernel = staticmethod(cook_torrance_kernel)
 
-        D = beckmann(h, p["m"], normalized=False)  # exp(−tan²α/m²)/(m² cos⁴α)
-        G = v_groove(n_h, n_v, n_l, v_h, l_h)
-        F = fresnel_dielectric_cook(c[..., None], p["ior"]).astype(dt, copy=False)
-
-        geo = G / (np.maximum(n_l, floor) * np.maximum(n_v, floor))
-        spec = (p["ks"] * (F / dt.type(np.pi)) * D[..., None]) * geo[..., None]
-        spec = np.minimum(spec, np.finfo(dt).max)
-        return spec + p["kd"] / dt.type(np.pi)
+    def kernel_args(self):
+        return self._pack(("kd", "ks", "m", "ior"))
 
 
 __all__ = ["CookTorrance"]

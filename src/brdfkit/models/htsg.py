@@ -114,9 +114,10 @@ tiers:
   (Q_n has degree n+1; the coefficients are derived exactly with rationals at
   import, :func:`asymptotic_coefficients`, ``ASYMPTOTIC_ORDER = 6``). The
   leading term is Beckmann's rough-surface limit. Its relative error in its
-  region is below 5e-8 (largest just above g = 40), falling fast with g.
+  region is below 1e-7 (largest just above g = 40: 9.8e-8 near g ≈ 43, found by an
+  independent comparison), falling fast with g.
 
-**Accuracy** (tests): relative error ≤ 1e-6 (measured: ≤ 4e-8) against a long
+**Accuracy** (tests): relative error ≤ 1e-6 (measured: ≤ 1e-7, 9.8e-8 near g ≈ 43) against a long
 log-space sum over every m and against 40-digit mpmath sums, for
 1e-4 ≤ g ≤ 1e5 and any T ≥ 0 (tested where Σ/g ≥ 1e-300; ``ln(Σ/g)`` stays
 accurate below that, only the value itself underflows to 0 far outside the lobe). These g cover the whole
@@ -127,13 +128,23 @@ Parameters
 ==============  ======  ====================  ===============  =============================================
 parameter       kind    default               range            meaning
 ==============  ======  ====================  ===============  =============================================
-sigma0          scalar  0.18                  [0, 2] µm        RMS surface height σ0 (0: a perfect mirror)
-tau             scalar  3.0                   [0.05, 100] µm   autocorrelation length τ
+sigma0          scalar  0.18                  [0, 2] µm        RMS surface height σ0 (0: a perfect mirror);
+                                                               fitted in [0.005, 1.5] µm
+tau             scalar  3.0                   [0.05, 100] µm   autocorrelation length τ; fitted in [0.3, 30] µm
+                                                               (log scale), so slopes 2σ0/τ up to 10
 eta             rgb     1.49, 0.96, 0.62      [0.01, 10]       refractive index n per channel
 k               rgb     7.82, 6.69, 5.46      [0, 20]          extinction coefficient per channel (0: dielectric)
 wavelengths     rgb     650, 550, 450         [200, 2000] nm   wavelength each RGB channel is evaluated at
 kd              rgb     0                     [0, 1]           uniform-diffuse albedo (kd/π)
+ks              rgb     1                     [0, 10]          scale of the surface reflection (directional
+                                                               diffuse and specular); 1 is the physical model
 ==============  ======  ====================  ===============  =============================================
+
+``ks`` is not part of the 1991 model (which is ks = 1): measured materials
+(paints, plastics) reflect less or more at their surface than the Fresnel factor
+of one set of optical constants predicts, and a fitter needs that freedom, as
+Ngan et al. (2005) give every lobe model an RGB weight. It multiplies ρ_dd and
+the coherent specular part alike, so the two stay in the ratio the physics sets.
 
 The defaults are the paper's aluminium example (σ0 = 0.18 µm, τ = 3 µm) with
 approximate optical constants of aluminium at the three wavelengths (after Rakić 1995).
@@ -141,15 +152,16 @@ approximate optical constants of aluminium at the three wavelengths (after Raki�
 
 from __future__ import annotations
 
+import math
 from fractions import Fraction
 from math import comb, factorial
 
 import numpy as np
-from scipy.special import erfc, gammaln
 
+from ..engine import jit, vectorize
 from ..params import Param
 from ..registry import register
-from ..terms.fresnel import fresnel_conductor
+from ..terms.fresnel import f_conductor, fresnel_conductor
 from .base import BRDF
 
 #: g at and above which the asymptotic form may be used
@@ -163,14 +175,19 @@ ASYMPTOTIC_A_POWER = 0.55
 WINDOW_LEFT = (6.0, 1.0)  # m* − 6 σ_m − 1
 WINDOW_RIGHT = (7.0, 4.0)  # m* + 7 σ_m + 4
 
-_SQRT_PI = np.sqrt(np.pi)
+_SQRT_PI = math.sqrt(math.pi)
 _TINY = 1e-300
+#: cap on S(θ)/cos θ: reached only for cos θ < 1e-150 with σ0 below ~1e-150 (no shadowing left to
+#: cancel the 1/cos); with it the product S_i S_o |v|⁴/(cos θi cos θr) stays finite, never 0·∞
+SHADOW_OVER_COS_CAP = 1e150
+_LN_8PI = math.log(8.0 * math.pi)
 
 
 # ---------------------------------------------------------------------------
 # Lambert W (principal branch, real argument z >= 0), given ln z
 # ---------------------------------------------------------------------------
-def lambertw_from_log(lz, iterations: int = 5) -> np.ndarray:
+@jit
+def lambertw_log(lz, iterations):
     """W(z) for ``z = exp(lz)`` ≥ 0 (``lz = -inf`` gives 0), without forming z when it would overflow.
 
     Newton's method on ``h(w) = w + ln w − ln z`` (concave, increasing), started at
@@ -179,15 +196,23 @@ def lambertw_from_log(lz, iterations: int = 5) -> np.ndarray:
     quadratically. 5 iterations reach machine precision for every ``lz`` in [-700, 1e300]
     (tested); below −700, W(z) = z to double precision.
     """
-    lz = np.asarray(lz, dtype=np.float64)
-    lzc = np.maximum(lz, -700.0)
-    small = lzc <= 1.0
-    w = np.where(small, np.log1p(np.exp(np.minimum(lzc, 1.0))), 0.0)
-    big = np.where(small, 2.0, lzc)
-    w = np.where(small, w, big - np.log(big))
-    for _ in range(iterations):
-        w = w - (w + np.log(w) - lzc) * w / (w + 1.0)
-    return np.where(lz < -700.0, np.exp(np.minimum(lz, -700.0)), w)
+    if lz < -700.0:
+        return math.exp(lz)
+    if lz <= 1.0:
+        w = math.log1p(math.exp(lz))
+    else:
+        w = lz - math.log(lz)
+    for _ in range(int(iterations)):
+        w = w - (w + math.log(w) - lz) * w / (w + 1.0)
+    return w
+
+
+_lambertw_v = vectorize(lambertw_log, 2)
+
+
+def lambertw_from_log(lz, iterations: int = 5) -> np.ndarray:
+    """Array form of :func:`lambertw_log` (float64, broadcasting)."""
+    return _lambertw_v(lz, float(iterations))
 
 
 # ---------------------------------------------------------------------------
@@ -237,134 +262,100 @@ def asymptotic_coefficients(order: int = ASYMPTOTIC_ORDER) -> list[list[Fraction
     return out
 
 
-_Q = [np.array([float(c) for c in q]) for q in asymptotic_coefficients(ASYMPTOTIC_ORDER)]
+_QS = [[float(c) for c in q] for q in asymptotic_coefficients(ASYMPTOTIC_ORDER)]
+#: Q_1..Q_N flattened (a tuple, a compile-time constant for numba): Q_n's coefficients (power of
+#: a ascending) start at _Q_OFF[n] and number n + 2
+_Q_FLAT = tuple(c for q in _QS for c in q)
+_Q_OFF = tuple(int(x) for x in np.cumsum([0] + [len(q) for q in _QS])[:-1])
 
 
-def _asymptotic_log_ratio(g, T):
-    """ln(Σ/g) from the asymptotic form (see module docstring)."""
+@jit
+def asymptotic_log_ratio(g, T):
+    """ln(Σ/g) from the asymptotic form ``Σ ≈ (e^(−a)/g)·exp(Σ_n Q_n(a)/g^n)``, a = T/g (module docstring)."""
     a = T / g
     eps = 1.0 / g
-    corr = np.zeros_like(g)
+    corr = 0.0
     for n in range(ASYMPTOTIC_ORDER, 0, -1):
-        q = _Q[n]
-        poly = np.full_like(a, q[-1])
-        for c in q[-2::-1]:
-            poly = poly * a + c
+        off = _Q_OFF[n]
+        poly = _Q_FLAT[off + n + 1]
+        for i in range(n, -1, -1):
+            poly = poly * a + _Q_FLAT[off + i]
         corr = (corr + poly) * eps
-    return -a - 2.0 * np.log(g) + corr
+    return -a - 2.0 * math.log(g) + corr
 
 
 # ---------------------------------------------------------------------------
 # The directional-diffuse series
 # ---------------------------------------------------------------------------
-_CHUNK = 8192  # elements per block of the direct sum (keeps the working set in cache)
 _MAX_RATIO_EXP = 600.0  # larger term-ratio exponents go to the log-space path
 
 
-def _log_term(m, lg, g, T):
+@jit
+def log_term(m, lg, g, T):
     """ln of the m-th term of Σ/g: (m−1) ln g − g − ln Γ(m+1) − ln m − T/m (real m ≥ 1)."""
-    return (m - 1.0) * lg - g - gammaln(m + 1.0) - np.log(m) - T / m
+    return (m - 1.0) * lg - g - math.lgamma(m + 1.0) - math.log(m) - T / m
 
 
-def _walk(g, T, m0, steps, right: bool):
-    """Σ_{j=1..steps} t_(m0±j)/t_(m0) with the exact ratio of consecutive terms (1-D arrays).
+@jit
+def direct_log_ratio(g, T):
+    """ln(Σ/g) by the windowed direct sum (g > 0, T ≥ 0).
 
-    ``t_m / t_(m−1) = g (m−1)/m² · exp(T/(m(m−1)))``. Elements are sorted by ``steps`` so that
-    every step works on a contiguous prefix, in blocks of ``_CHUNK`` to stay in cache.
+    The window ``[lo, hi]`` surrounds the saddle point m* = g exp(W(2T/g²)/2) (width
+    σ_m = (1/m* + 2T/m*³)^(−1/2)); the terms are accumulated relative to the term at
+    ``m_c = round(m*)``, walking right to ``hi`` and left to ``lo`` with the exact ratio of
+    consecutive terms ``t_m/t_(m−1) = g (m−1)/m² · exp(T/(m(m−1)))``, so nothing overflows
+    or underflows near the peak. Where the first ratio's exponent passes 600 the sum is
+    taken in log space instead.
     """
-    total = np.zeros_like(g)
-    for c0 in range(0, g.size, _CHUNK):
-        ii = c0 + np.argsort(-steps[c0 : c0 + _CHUNK])
-        st = steps[ii]  # descending
-        if st.size == 0 or st[0] <= 0:
-            continue
-        gg, TT, m = g[ii], T[ii], m0[ii].copy()
-        t = np.ones_like(gg)
-        acc = np.zeros_like(gg)
-        q = np.empty_like(gg)
-        e = np.empty_like(gg)
-        n_act = ii.size
-        for s in range(1, int(st[0]) + 1):
-            while n_act and st[n_act - 1] < s:
-                n_act -= 1
-            mv, qv, ev, tv = m[:n_act], q[:n_act], e[:n_act], t[:n_act]
-            if right:
-                mv += 1.0  # t_m = t_(m−1) · g (m−1)/m² · exp(T/(m(m−1)))
-                np.multiply(mv, mv, out=qv)
-                np.subtract(qv, mv, out=ev)
-                np.divide(TT[:n_act], ev, out=ev)
-                np.exp(ev, out=ev)
-                ev *= gg[:n_act]
-                ev /= qv
-                np.subtract(mv, 1.0, out=qv)
-                ev *= qv
-            else:  # t_(m−1) = t_m · m²/(g (m−1)) · exp(−T/(m(m−1)))
-                np.multiply(mv, mv, out=qv)
-                np.subtract(qv, mv, out=ev)
-                np.divide(TT[:n_act], ev, out=ev)
-                np.negative(ev, out=ev)
-                np.exp(ev, out=ev)
-                ev *= qv
-                np.subtract(mv, 1.0, out=mv)
-                np.multiply(mv, gg[:n_act], out=qv)
-                ev /= qv
-            tv *= ev
-            acc[:n_act] += tv
-        total[ii] = acc
-    return total
+    lg = math.log(g)
+    w = lambertw_log(math.log(2.0 * T) - 2.0 * lg, 3.0) if T > 0.0 else 0.0
+    mstar = max(g * math.exp(0.5 * w), 1.0)
+    sig = 1.0 / math.sqrt(1.0 / mstar + 2.0 * T / (mstar * mstar * mstar))
+    lo = max(math.floor(mstar - WINDOW_LEFT[0] * sig - WINDOW_LEFT[1]), 1.0)
+    hi = math.ceil(mstar + WINDOW_RIGHT[0] * sig + WINDOW_RIGHT[1])
+    mc = min(max(math.floor(mstar + 0.5), lo), hi)
+    if T / (mc * (mc + 1.0)) > _MAX_RATIO_EXP:
+        mx = -math.inf
+        m = lo
+        while m <= hi:
+            mx = max(mx, log_term(m, lg, g, T))
+            m += 1.0
+        acc = 0.0
+        m = lo
+        while m <= hi:
+            acc += math.exp(log_term(m, lg, g, T) - mx)
+            m += 1.0
+        return mx + math.log(acc)
+    acc = 1.0
+    t = 1.0
+    m = mc + 1.0
+    while m <= hi:  # right: t_m = t_(m−1) · g (m−1)/m² · exp(T/(m(m−1)))
+        t *= g * (m - 1.0) / (m * m) * math.exp(T / (m * (m - 1.0)))
+        acc += t
+        m += 1.0
+    t = 1.0
+    m = mc
+    while m > lo:  # left: t_(m−1) = t_m · m²/(g (m−1)) · exp(−T/(m(m−1)))
+        t *= m * m / (g * (m - 1.0)) * math.exp(-T / (m * (m - 1.0)))
+        acc += t
+        m -= 1.0
+    return log_term(mc, lg, g, T) + math.log(acc)
 
 
-def _direct_log_ratio(g, T):
-    """ln(Σ/g) by the windowed direct sum (1-D arrays, g > 0).
-
-    The window ``[lo, hi]`` surrounds the saddle point; the terms are accumulated relative to
-    the term at ``m_c = round(m*)``, walking right to ``hi`` and left to ``lo``, so nothing
-    overflows or underflows near the peak.
-    """
-    lg = np.log(g)
-    # saddle point m* = g exp(W(2T/g²)/2) and peak width σ_m
-    with np.errstate(divide="ignore"):
-        lz = np.log(2.0 * T) - 2.0 * lg
-    mstar = np.maximum(g * np.exp(0.5 * lambertw_from_log(lz, iterations=3)), 1.0)
-    sig = 1.0 / np.sqrt(1.0 / mstar + 2.0 * T / mstar**3)
-    lo = np.maximum(np.floor(mstar - WINDOW_LEFT[0] * sig - WINDOW_LEFT[1]), 1.0)
-    hi = np.ceil(mstar + WINDOW_RIGHT[0] * sig + WINDOW_RIGHT[1])
-    mc = np.clip(np.round(mstar), lo, hi)
-    lc = _log_term(mc, lg, g, T)
-    out = np.empty_like(g)
-    # the right walk's first ratio has the largest exponent; beyond _MAX_RATIO_EXP use logs
-    safe = T / (mc * (mc + 1.0)) <= _MAX_RATIO_EXP
-    for i in np.nonzero(~safe)[0]:
-        m = np.arange(lo[i], hi[i] + 1.0)
-        ll = _log_term(m, lg[i], g[i], T[i])
-        mx = ll.max()
-        out[i] = mx + np.log(np.exp(ll - mx).sum())
-    s = np.nonzero(safe)[0]
-    if s.size:
-        gs, Ts, ms = g[s], T[s], mc[s]
-        acc = 1.0 + _walk(gs, Ts, ms, (hi[s] - ms).astype(np.int64), True)
-        acc += _walk(gs, Ts, ms, (ms - lo[s]).astype(np.int64), False)
-        out[s] = lc[s] + np.log(acc)
-    return out
+@jit
+def log_series_ratio(g, T):
+    """``ln(Σ(g, T)/g)`` (finite for g ≥ 0, T ≥ 0; g = 0 gives −T, the limit): the two tiers."""
+    g = max(g, _TINY)
+    T = max(T, 0.0)
+    if g >= ASYMPTOTIC_G and T / g <= ASYMPTOTIC_A_SCALE * math.exp(ASYMPTOTIC_A_POWER * math.log(g)):
+        return asymptotic_log_ratio(g, T)
+    return direct_log_ratio(g, T)
 
 
-def htsg_log_series_ratio(g, T) -> np.ndarray:
-    """``ln(Σ(g, T)/g)`` (finite for g ≥ 0, T ≥ 0; g = 0 gives −T, the limit)."""
-    g = np.asarray(g, dtype=np.float64)
-    T = np.asarray(T, dtype=np.float64)
-    g, T = np.broadcast_arrays(g, T)
-    shape = g.shape
-    g = np.maximum(g.ravel(), _TINY)
-    T = np.maximum(T.ravel(), 0.0)
-    out = np.empty_like(g)
-    a = T / g
-    asym = (g >= ASYMPTOTIC_G) & (a <= ASYMPTOTIC_A_SCALE * g**ASYMPTOTIC_A_POWER)
-    if asym.any():
-        out[asym] = _asymptotic_log_ratio(g[asym], T[asym])
-    direct = ~asym
-    if direct.any():
-        out[direct] = _direct_log_ratio(g[direct], T[direct])
-    return out.reshape(shape)
+_asymptotic_log_ratio = vectorize(asymptotic_log_ratio, 2)
+_direct_log_ratio = vectorize(direct_log_ratio, 2)
+htsg_log_series_ratio = vectorize(log_series_ratio, 2)
+htsg_log_series_ratio.__doc__ = "``ln(Σ(g, T)/g)`` elementwise, float64 (array form of :func:`log_series_ratio`)."
 
 
 def htsg_series(g, T) -> np.ndarray:
@@ -376,56 +367,115 @@ def htsg_series(g, T) -> np.ndarray:
 # ---------------------------------------------------------------------------
 # Shadowing and effective roughness
 # ---------------------------------------------------------------------------
-def _cos_sin(c):
-    c = np.clip(np.asarray(c, dtype=np.float64), 0.0, 1.0)
-    s = np.sqrt(np.maximum(0.0, (1.0 - c) * (1.0 + c)))
-    return c, s
+@jit
+def shadowing_over_cos_c(c, sigma0, tau):
+    """``S(θ)/cos θ`` (eqs. 24–25 with the erratum), finite down to cos θ = 0 for σ0 > 0.
 
-
-def shadowing_over_cos(c, sigma0: float, tau: float) -> np.ndarray:
-    """``S(θ)/cos θ`` (eqs. 24–25 with the erratum), finite down to cos θ = 0 for σ0 > 0."""
-    c, s = _cos_sin(c)
-    if sigma0 <= 0:
-        return 1.0 / np.maximum(c, _TINY)
-    with np.errstate(divide="ignore", over="ignore", invalid="ignore"):
-        a = np.where(s > 0, tau * c / (2.0 * sigma0 * np.where(s > 0, s, 1.0)), np.inf)
-        ea = np.exp(-a * a)
-        ec = erfc(a)
-    # (1 + Λ) cos θ = c (1 − ½ erfc a) + σ0 s e^(−a²) / (√π τ): no 1/a, positive
-    den = c * (1.0 - 0.5 * ec) + sigma0 * s * ea / (_SQRT_PI * tau)
-    return (1.0 - 0.5 * ec) / np.maximum(den, _TINY)
-
-
-def shadowing(c, sigma0: float, tau: float) -> np.ndarray:
-    """Smith shadowing ``S(θ)`` of HTSG eqs. 24–25 (with the e^(−a²) erratum), from cos θ."""
-    c, _ = _cos_sin(c)
-    return np.clip(shadowing_over_cos(c, sigma0, tau) * c, 0.0, 1.0)
-
-
-def _K(c, sigma0: float, tau: float):
-    c, s = _cos_sin(c)
-    c = np.maximum(c, 1e-150)
-    t = s / c
-    with np.errstate(divide="ignore", over="ignore"):
-        return np.where(t > 0, t * erfc(tau / (2.0 * sigma0 * np.where(t > 0, t, 1.0))), 0.0)
-
-
-def z0_ratio_squared(cos_i, cos_r, sigma0: float, tau: float) -> np.ndarray:
-    """``(z0/σ0)²`` solving eq. 80–83, ``√(π/2) z0 = (σ0/4)(K_i + K_r) exp(−z0²/(2σ0²))``.
-
-    With x = z0/σ0: ``x² e^(x²) = (K_i + K_r)²/(8π)``, so ``x² = W((K_i + K_r)²/(8π))``.
+    With ``a = τ cot θ/(2σ0)``: ``(1 + Λ) cos θ = c (1 − ½ erfc a) + σ0 s e^(−a²)/(√π τ)``
+    (no 1/a, positive), so ``S/cos θ = (1 − ½ erfc a)/((1 + Λ) cos θ)``.
     """
-    if sigma0 <= 0:
-        return np.zeros(np.broadcast(np.asarray(cos_i), np.asarray(cos_r)).shape)
-    kk = _K(cos_i, sigma0, tau) + _K(cos_r, sigma0, tau)
-    with np.errstate(divide="ignore"):
-        lz = 2.0 * np.log(kk) - np.log(8.0 * np.pi)
-    return lambertw_from_log(lz)
+    c = min(max(c, 0.0), 1.0)
+    if sigma0 <= 0.0:
+        return min(1.0 / max(c, _TINY), SHADOW_OVER_COS_CAP)
+    s = math.sqrt(max(0.0, (1.0 - c) * (1.0 + c)))
+    if s > 0.0:
+        a = tau * c / (2.0 * sigma0) / s  # 2σ0·s would underflow to 0 for tiny σ0
+        ea = math.exp(-min(a * a, 1e300))
+        ec = math.erfc(a)
+    else:
+        ea = 0.0
+        ec = 0.0
+    den = c * (1.0 - 0.5 * ec) + sigma0 * s * ea / (_SQRT_PI * tau)
+    return min((1.0 - 0.5 * ec) / max(den, _TINY), SHADOW_OVER_COS_CAP)
 
 
-def effective_roughness(cos_i, cos_r, sigma0: float, tau: float) -> np.ndarray:
+@jit
+def shadowing_c(c, sigma0, tau):
+    """Smith shadowing ``S(θ)`` of HTSG eqs. 24–25 (with the e^(−a²) erratum), from cos θ."""
+    c = min(max(c, 0.0), 1.0)
+    return min(max(shadowing_over_cos_c(c, sigma0, tau) * c, 0.0), 1.0)
+
+
+@jit
+def roughness_K(c, sigma0, tau):
+    """``K = tan θ · erfc(τ/(2 σ0 tan θ))`` of eqs. 80–83 (0 at normal incidence)."""
+    c = min(max(c, 0.0), 1.0)
+    s = math.sqrt(max(0.0, (1.0 - c) * (1.0 + c)))
+    t = s / max(c, 1e-150)
+    if t > 0.0:
+        return t * math.erfc(tau / (2.0 * sigma0) / t)  # 2σ0·t would underflow to 0 for tiny σ0
+    return 0.0
+
+
+@jit
+def z0_ratio_squared_c(cos_i, cos_r, sigma0, tau):
+    """``(z0/σ0)²`` solving eqs. 80–83: ``x² e^(x²) = (K_i + K_r)²/(8π)``, so ``x² = W((K_i + K_r)²/(8π))``."""
+    if sigma0 <= 0.0:
+        return 0.0
+    kk = roughness_K(cos_i, sigma0, tau) + roughness_K(cos_r, sigma0, tau)
+    if kk <= 0.0:
+        return 0.0
+    return lambertw_log(2.0 * math.log(kk) - _LN_8PI, 5.0)
+
+
+@jit
+def effective_roughness_c(cos_i, cos_r, sigma0, tau):
     """σ = σ0 / sqrt(1 + (z0/σ0)²) of eqs. 80–83 (µm), from the two cosines."""
-    return sigma0 / np.sqrt(1.0 + z0_ratio_squared(cos_i, cos_r, sigma0, tau))
+    return sigma0 / math.sqrt(1.0 + z0_ratio_squared_c(cos_i, cos_r, sigma0, tau))
+
+
+shadowing_over_cos = vectorize(shadowing_over_cos_c, 3)
+shadowing = vectorize(shadowing_c, 3)
+z0_ratio_squared = vectorize(z0_ratio_squared_c, 4)
+effective_roughness = vectorize(effective_roughness_c, 4)
+
+
+@jit
+def directional_diffuse_channel(lam_nm, eta, k, ks, sigma, tau, vz, vxy2, cos_local, geo):
+    """ρ_dd of one channel (eqs. 76–84): ``ks·|F|²·G·S·D/(π cos θi cos θr)`` as
+
+    ``ks · F · geo · (2πσ/λ)² (πτ/(2λ))² · (Σ/g)`` with ``geo = |v|⁴ S_i/ci · S_o/co / π``,
+    g = (2πσ/λ)² vz², T = (πτ/λ)² v_xy² (λ in µm).
+    """
+    lam = lam_nm * 1e-3
+    k2 = (2.0 * math.pi * sigma / lam) * (2.0 * math.pi * sigma / lam)
+    g = k2 * vz * vz
+    T = (math.pi * tau / lam) * (math.pi * tau / lam) * vxy2
+    ratio = math.exp(min(log_series_ratio(g, T), 700.0))
+    F = f_conductor(cos_local, eta, k)
+    q = math.pi * tau / (2.0 * lam)
+    # the bounded factors first (ratio may underflow to 0), the large geometric one last
+    return (ks * F * k2 * (q * q) * ratio) * geo
+
+
+@jit
+def htsg_kernel(wix, wiy, wiz, wox, woy, woz, p, c):
+    """HTSG per pair (engine protocol, :mod:`brdfkit.engine`): ρ_dd + kd/π.
+
+    ``p`` = [sigma0, tau, eta (3), k (3), wavelengths (3), kd (3), ks (3)]; ``c`` unused.
+    """
+    sigma0 = p[0]
+    tau = p[1]
+    d0 = p[11] / math.pi
+    d1 = p[12] / math.pi
+    d2 = p[13] / math.pi
+    if sigma0 <= 0.0:
+        return d0, d1, d2
+    ci = min(max(wiz, 0.0), 1.0)
+    co = min(max(woz, 0.0), 1.0)
+    vx = wix + wox
+    vy = wiy + woy
+    vz = ci + co
+    vxy2 = vx * vx + vy * vy
+    v2 = vxy2 + vz * vz  # |wi + wo|²
+    sigma = effective_roughness_c(ci, co, sigma0, tau)
+    geo = v2 * v2 * shadowing_over_cos_c(ci, sigma0, tau) * shadowing_over_cos_c(co, sigma0, tau) / math.pi
+    cos_local = min(max(0.5 * math.sqrt(v2), 0.0), 1.0)
+    return (
+        directional_diffuse_channel(p[8], p[2], p[5], p[14], sigma, tau, vz, vxy2, cos_local, geo) + d0,
+        directional_diffuse_channel(p[9], p[3], p[6], p[15], sigma, tau, vz, vxy2, cos_local, geo) + d1,
+        directional_diffuse_channel(p[10], p[4], p[7], p[16], sigma, tau, vz, vxy2, cos_local, geo) + d2,
+    )
 
 
 # ---------------------------------------------------------------------------
@@ -446,14 +496,16 @@ class HTSG(BRDF):
     isotropic = True
     spec = (
         Param("sigma0", "scalar", 0.18, (0.0, 2.0), "µm", "RMS surface height σ0 (0 is a perfect mirror)",
-              fit_range=(0.0, 1.0)),
+              fit_range=(0.005, 1.5)),
         Param("tau", "scalar", 3.0, (0.05, 100.0), "µm", "autocorrelation length τ of the surface heights",
-              log_scale=True),
+              fit_range=(0.3, 30.0), log_scale=True),
         Param("eta", "rgb", _AL_ETA, (0.01, 10.0), "", "refractive index n per channel (default: aluminium)"),
         Param("k", "rgb", _AL_K, (0.0, 20.0), "", "extinction coefficient per channel (0 for a dielectric)"),
         Param("wavelengths", "rgb", (650.0, 550.0, 450.0), (200.0, 2000.0), "nm",
               "wavelength at which each RGB channel is evaluated", fit=False),
         Param("kd", "rgb", 0.0, (0.0, 1.0), "", "uniform-diffuse albedo (the term kd/π)"),
+        Param("ks", "rgb", 1.0, (0.0, 10.0), "", "scale of the surface reflection (directional diffuse and "
+              "specular; 1 = the 1991 model)", fit_range=(0.0, 3.0)),
     )
 
     def _setup(self) -> None:
@@ -464,45 +516,28 @@ class HTSG(BRDF):
         self._eta = np.asarray(p["eta"], dtype=np.float64)
         self._k = np.asarray(p["k"], dtype=np.float64)
         self._kd = np.asarray(p["kd"], dtype=np.float64)
+        self._ks = np.asarray(p["ks"], dtype=np.float64)
 
     # -- parts -------------------------------------------------------------
+    kernel = staticmethod(htsg_kernel)
+
+    def kernel_args(self):
+        return self._pack(("sigma0", "tau", "eta", "k", "wavelengths", "kd", "ks"))
+
     def directional_diffuse(self, wi, wo) -> np.ndarray:
-        """ρ_dd(wi, wo) (1/sr, RGB, float64), directions strictly above the horizon assumed."""
+        """ρ_dd(wi, wo) (1/sr, RGB, float64): the kernel with kd = 0."""
         wi = np.asarray(wi, dtype=np.float64)
         wo = np.asarray(wo, dtype=np.float64)
-        wi, wo = np.broadcast_arrays(wi, wo)
-        shape = wi.shape
         if self._sigma0 <= 0:
-            return np.zeros(shape)
-        ci = np.clip(wi[..., 2], 0.0, 1.0)
-        co = np.clip(wo[..., 2], 0.0, 1.0)
-        vx = wi[..., 0] + wo[..., 0]
-        vy = wi[..., 1] + wo[..., 1]
-        vz = ci + co
-        vxy2 = vx * vx + vy * vy
-        v2 = vxy2 + vz * vz  # |wi + wo|², = 2 (1 + wi·wo)
-        sigma = effective_roughness(ci, co, self._sigma0, self._tau)
-        lam = self._lam
-        # per channel: g = (2πσ/λ)² vz²,  T = (πτ/λ)² v_xy²
-        k2 = (2.0 * np.pi * sigma[..., None] / lam) ** 2  # (2πσ/λ)²
-        g = k2 * (vz * vz)[..., None]
-        T = (np.pi * self._tau / lam) ** 2 * vxy2[..., None]
-        ratio = np.exp(htsg_log_series_ratio(g, T))  # Σ/g
-        # G·D·S/(π ci co) = |v|⁴/vz² · (π τ/(2λ))² · g·(Σ/g) · S_i/ci · S_o/co / π
-        #                 = |v|⁴ · (2πσ/λ)² (πτ/(2λ))² (Σ/g) · S_i/ci · S_o/co / π
-        Si = shadowing_over_cos(ci, self._sigma0, self._tau)
-        So = shadowing_over_cos(co, self._sigma0, self._tau)
-        geo = (v2 * v2 * Si * So / np.pi)[..., None]
-        cos_local = np.clip(0.5 * np.sqrt(v2), 0.0, 1.0)
-        F = fresnel_conductor(cos_local[..., None], self._eta, self._k)
-        return F * geo * k2 * (np.pi * self._tau / (2.0 * lam)) ** 2 * ratio
+            return np.zeros(np.broadcast_shapes(wi.shape, wo.shape))
+        return self.with_params(kd=0.0).eval(wi, wo)
 
     def delta_reflectance(self, w) -> np.ndarray:
         """The coherent mirror part (see :meth:`specular_reflectance`), for albedo and energy checks."""
         return self.specular_reflectance(w)
 
     def specular_reflectance(self, wi) -> np.ndarray:
-        """Fraction of the incident power in the coherent mirror reflection: ``|F(θi)|² e^(−g) S(θi)²``.
+        """Fraction of the incident power in the coherent mirror reflection: ``ks·|F(θi)|² e^(−g) S(θi)²``.
 
         ``wi`` (..., 3) toward the light; returns (..., 3) RGB (0 where ``wi.z <= 0``); float32 in
         gives float32 out. The reflected direction is :meth:`specular_direction`.
@@ -522,8 +557,8 @@ class HTSG(BRDF):
             g = (2.0 * np.pi * sigma[..., None] / self._lam) ** 2 * (2.0 * c[..., None]) ** 2
             S = shadowing(c, self._sigma0, self._tau) ** 2
             out = F * np.exp(-g) * S[..., None]
-        out = np.where(valid[..., None], out, 0.0)
-        return np.clip(out, 0.0, 1.0).astype(dtype)
+        out = np.where(valid[..., None], self._ks * out, 0.0)
+        return np.clip(out, 0.0, None).astype(dtype)
 
     @staticmethod
     def specular_direction(wi) -> np.ndarray:
@@ -537,10 +572,6 @@ class HTSG(BRDF):
         """ρ_ud = kd/π, broadcast to (..., 3)."""
         shape = np.broadcast(np.asarray(wi), np.asarray(wo)).shape
         return np.broadcast_to(self._kd / np.pi, shape)
-
-    # -- the contract ---------------------------------------------------------
-    def _eval(self, wi, wo, p):
-        return self.directional_diffuse(wi, wo) + self._kd / np.pi
 
 
 __all__ = [

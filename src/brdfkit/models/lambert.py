@@ -17,11 +17,18 @@ kd         rgb    0.5      [0, 1]    diffuse albedo
 
 from __future__ import annotations
 
-import numpy as np
+import math
 
+from ..engine import jit
 from ..params import kd_param
 from ..registry import register
 from .base import BRDF
+
+
+@jit
+def lambert_kernel(wix, wiy, wiz, wox, woy, woz, p, c):
+    """kd/π per channel; ``p = [kd_r, kd_g, kd_b]``, ``c`` unused."""
+    return p[0] / math.pi, p[1] / math.pi, p[2] / math.pi
 
 
 @register
@@ -31,6 +38,7 @@ class Lambert(BRDF):
     reference = "Lambert, Photometria (1760)"
     spec = (kd_param(0.5),)
 
-    def _eval(self, wi, wo, p):
-        kd = p["kd"]
-        return np.broadcast_to(kd / kd.dtype.type(np.pi), wi.shape)
+    kernel = staticmethod(lambert_kernel)
+
+    def kernel_args(self):
+        return self._pack(("kd",))

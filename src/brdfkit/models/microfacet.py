@@ -69,12 +69,15 @@ from typing import Any
 
 import numpy as np
 
-from ..geometry import half_vector
+import math
+
+from ..engine import jit
+from ..geometry import half_vector_c
 from ..params import Param, kd_param, ks_param
 from ..registry import register
-from ..terms.distributions import distribution as _distribution
-from ..terms.fresnel import fresnel_conductor, fresnel_dielectric_cook, fresnel_schlick
-from ..terms.shadowing import g1_from_lambda, v_groove
+from ..terms.distributions import d_of, lambda_of
+from ..terms.fresnel import f_conductor, f_dielectric, f_schlick, fresnel_conductor, fresnel_dielectric_cook, fresnel_schlick
+from ..terms.shadowing import g1_smith, g_vgroove
 from .base import BRDF
 
 GOLD_ETA = (0.143119, 0.374957, 1.442479)
@@ -95,8 +98,12 @@ _ALPHA_X = Param("alpha_x", "scalar", ALPHA_DEFAULT, ALPHA_RANGE, "",
 _ALPHA_Y = Param("alpha_y", "scalar", ALPHA_DEFAULT, ALPHA_RANGE, "",
                  "roughness along the bitangent +y (anisotropic use)", log_scale=True)
 
-# cosines are floored here in the 1/(4 cos cos) factor so that it stays finite
-_COS_FLOOR = {np.dtype(np.float32): 1e-18, np.dtype(np.float64): 1e-150}
+# cosines are floored in the 1/(4 cos cos) factor so that it stays finite (kernels compute in float64)
+COS_FLOOR = 1e-150
+
+#: kernel choice indices (the order of the Param choices below)
+SMITH, SMITH_CORRELATED, V_GROOVE = 0, 1, 2
+CONDUCTOR, DIELECTRIC, SCHLICK, NO_FRESNEL = 0, 1, 2, 3
 
 
 def resolve_roughness(model: str, given: dict[str, Any], by_name: dict[str, Param]) -> dict[str, Any]:
@@ -128,6 +135,55 @@ def fresnel_term(kind: str, c: np.ndarray, p: dict[str, Any], dtype) -> np.ndarr
     if kind == "schlick":
         return fresnel_schlick(p["f0"], c3).astype(dtype, copy=False)
     return np.ones(c.shape + (3,), dtype=dtype)
+
+
+@jit
+def fresnel_of(kind, c, eta, k, f0):
+    """F(c) for the ``fresnel`` choice index ``kind`` (one channel)."""
+    if kind == CONDUCTOR:
+        return f_conductor(c, eta, k)
+    if kind == DIELECTRIC:
+        return f_dielectric(c, eta)
+    if kind == SCHLICK:
+        return f_schlick(f0, c)
+    return 1.0
+
+
+@jit
+def shadowing_of(kind, dist, wix, wiy, wiz, wox, woy, woz, hz, lh, vh, ax, ay):
+    """G for the ``shadowing`` choice index ``kind``: separable Smith, height-correlated Smith, V-groove."""
+    if kind == V_GROOVE:
+        return g_vgroove(hz, woz, wiz, vh, lh)
+    lam_i = lambda_of(dist, wix, wiy, wiz, ax, ay)
+    lam_o = lambda_of(dist, wox, woy, woz, ax, ay)
+    if kind == SMITH:
+        return g1_smith(lam_i) * g1_smith(lam_o)
+    return g1_smith(lam_i + lam_o)
+
+
+@jit
+def microfacet_kernel(wix, wiy, wiz, wox, woy, woz, p, c):
+    """Walter et al. (2007) eq. 20: kd/π + ks·F(c)·D(h)·G/(4 (n·wi)(n·wo)), per RGB channel.
+
+    ``p = [alpha_x, alpha_y, eta(3), k(3), f0(3), kd(3), ks(3)]``;
+    ``c = [distribution, shadowing, fresnel]`` (indices into the Param choices).
+    """
+    ax = p[0]
+    ay = p[1]
+    hx, hy, hz = half_vector_c(wix, wiy, wiz, wox, woy, woz)  # h_z > 0: both directions are above the horizon
+    lh = wix * hx + wiy * hy + wiz * hz
+    vh = wox * hx + woy * hy + woz * hz
+    cc = min(max(0.5 * (lh + vh), 0.0), 1.0)  # wi·h = wo·h; the mean keeps F reciprocal to the last bit
+    D = d_of(c[0], hx, hy, hz, ax, ay)
+    G = shadowing_of(c[1], c[0], wix, wiy, wiz, wox, woy, woz, hz, lh, vh, ax, ay)
+    geo = G / (4.0 * max(wiz, COS_FLOOR) * max(woz, COS_FLOOR))
+    # ks·F·D first (finite, at most 1/(π α²)), then G/(4 cos cos) (finite thanks to the floor)
+    sr = (p[14] * fresnel_of(c[2], cc, p[2], p[5], p[8]) * D) * geo
+    sg = (p[15] * fresnel_of(c[2], cc, p[3], p[6], p[9]) * D) * geo
+    sb = (p[16] * fresnel_of(c[2], cc, p[4], p[7], p[10]) * D) * geo
+    # multiple scattering between microfacets (the `multiscatter` option, Kulla & Conty 2017)
+    # is added to sr, sg, sb here, as its own scalar term function.
+    return sr + p[11] / math.pi, sg + p[12] / math.pi, sb + p[13] / math.pi
 
 
 @register
@@ -187,36 +243,10 @@ class Microfacet(BRDF):
         new.update(changes)
         return type(self)(**new)
 
-    def _eval(self, wi, wo, p):
-        dt = wi.dtype
-        one = dt.type(1)
-        floor = dt.type(_COS_FLOOR[dt])
-        d_fn, lam_fn = _distribution(p["distribution"])
-        ax, ay = p["alpha_x"], p["alpha_y"]
+    kernel = staticmethod(microfacet_kernel)
 
-        h = half_vector(wi, wo)  # h_z > 0 since both directions are above the horizon
-        cos_i = wi[..., 2]
-        cos_o = wo[..., 2]
-        lh = np.einsum("...i,...i->...", wi, h)
-        vh = np.einsum("...i,...i->...", wo, h)
-        c = np.clip(dt.type(0.5) * (lh + vh), dt.type(0), one)  # wi·h = wo·h; symmetric for reciprocity
-
-        D = d_fn(h, ax, ay)
-        sh = p["shadowing"]
-        if sh == "smith":
-            G = g1_from_lambda(lam_fn(wi, ax, ay)) * g1_from_lambda(lam_fn(wo, ax, ay))
-        elif sh == "smith-correlated":
-            G = g1_from_lambda(lam_fn(wi, ax, ay) + lam_fn(wo, ax, ay))
-        else:
-            G = v_groove(h[..., 2], cos_o, cos_i, vh, lh)
-
-        F = fresnel_term(p["fresnel"], c, p, dt)
-        # ks·F·D first (finite, bounded by 1/(π α²)), then G/(4 cos cos) (finite thanks to the floor):
-        # a product of finite factors can only overflow, never give NaN; clamp the overflow.
-        geo = G / (dt.type(4) * np.maximum(cos_i, floor) * np.maximum(cos_o, floor))
-        spec = (p["ks"] * F * D[..., None]) * geo[..., None]
-        spec = np.minimum(spec, np.finfo(dt).max)
-        return spec + p["kd"] / dt.type(np.pi)
+    def kernel_args(self):
+        return self._pack(("alpha_x", "alpha_y", "eta", "k", "f0", "kd", "ks"), ("distribution", "shadowing", "fresnel"))
 
 
-__all__ = ["Microfacet", "GOLD_ETA", "GOLD_K", "GOLD_F0", "resolve_roughness", "fresnel_term"]
+__all__ = ["Microfacet", "microfacet_kernel", "GOLD_ETA", "GOLD_K", "GOLD_F0", "resolve_roughness", "fresnel_term"]

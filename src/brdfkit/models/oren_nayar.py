@@ -80,8 +80,11 @@ variant    choice  qualitative  qualitative | full     the A,B model or the full
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
+from ..engine import jit
 from ..params import Param, kd_param
 from ..registry import register
 from .base import BRDF
@@ -90,16 +93,72 @@ from .base import BRDF
 COS_FLOOR = 1e-6
 
 
-def _angles(w):
-    """sin θ, cos θ, θ and the unit azimuth vector (cos φ, sin φ) (zeros at the normal)."""
-    x, y, z = w[..., 0], w[..., 1], w[..., 2]
-    s = np.hypot(x, y)
-    theta = np.arctan2(s, z)
-    safe = s > 0
-    d = np.where(safe, s, 1)
-    cphi = np.where(safe, x / d, 0)
-    sphi = np.where(safe, y / d, 0)
-    return s, z, theta, cphi, sphi
+@jit
+def polar_angles(x, y, z):
+    """sin θ, cos θ, θ and the unit azimuth vector (cos φ, sin φ) of a direction (zeros at the normal)."""
+    st = math.hypot(x, y)
+    theta = math.atan2(st, z)
+    if st > 0.0:
+        return st, z, theta, x / st, y / st
+    return st, z, theta, 0.0, 0.0
+
+
+@jit
+def oren_nayar_qualitative(sig2, cos_dphi, sin_a, tan_b):
+    """The lecture's A + B·max(0, cos(φi − φo))·sin α·tan β (Oren & Nayar 1994, eq. 30)."""
+    A = 1.0 - 0.5 * sig2 / (sig2 + 0.33)
+    B = 0.45 * sig2 / (sig2 + 0.09)
+    return A + B * max(cos_dphi, 0.0) * sin_a * tan_b
+
+
+@jit
+def oren_nayar_direct(sig2, cos_dphi, alpha, beta, sin_a, sin_b, cos_a, cos_b, tan_b):
+    """The full model's direct term C1 + cos Δφ C2 tan β + (1 − |cos Δφ|) C3 tan((α+β)/2), floored at 0."""
+    two_b_pi = 2.0 * beta / math.pi
+    C1 = 1.0 - 0.5 * sig2 / (sig2 + 0.33)
+    k2 = 0.45 * sig2 / (sig2 + 0.09)
+    if cos_dphi >= 0.0:
+        C2 = k2 * sin_a
+    else:
+        C2 = k2 * (sin_a - two_b_pi * two_b_pi * two_b_pi)
+    q = 4.0 * alpha * beta / (math.pi * math.pi)
+    C3 = 0.125 * sig2 / (sig2 + 0.09) * (q * q)
+    tan_half = (sin_a + sin_b) / max(cos_a + cos_b, COS_FLOOR)
+    g1 = C1 + cos_dphi * C2 * tan_b + (1.0 - abs(cos_dphi)) * C3 * tan_half
+    return max(g1, 0.0)  # the fit dips below 0 for large σ, grazing, Δφ ≈ π
+
+
+@jit
+def oren_nayar_interreflection(sig2, cos_dphi, beta):
+    """The full model's interreflection factor 0.17 σ²/(σ² + 0.13) (1 − cos Δφ (2β/π)²), times ρ²/π."""
+    two_b_pi = 2.0 * beta / math.pi
+    return 0.17 * sig2 / (sig2 + 0.13) * (1.0 - cos_dphi * two_b_pi * two_b_pi)
+
+
+@jit
+def oren_nayar_kernel(wix, wiy, wiz, wox, woy, woz, p, c):
+    """Oren & Nayar (1994): ``p = [kd(3), sigma]``, ``c = [variant]`` (0 qualitative, 1 full)."""
+    sig2 = p[3] * p[3]
+    si, ci, ti, cpi, spi = polar_angles(wix, wiy, wiz)
+    so, co, to, cpo, spo = polar_angles(wox, woy, woz)
+    cos_dphi = min(max(cpi * cpo + spi * spo, -1.0), 1.0)
+    sin_a = max(si, so)  # α = max(θi, θo): the larger sine, the smaller cosine
+    cos_a = min(ci, co)
+    sin_b = min(si, so)
+    cos_b = max(ci, co)
+    tan_b = sin_b / max(cos_b, COS_FLOOR)
+    if c[0] == 0:
+        g = oren_nayar_qualitative(sig2, cos_dphi, sin_a, tan_b)
+        return p[0] / math.pi * g, p[1] / math.pi * g, p[2] / math.pi * g
+    alpha = max(ti, to)
+    beta = min(ti, to)
+    g1 = oren_nayar_direct(sig2, cos_dphi, alpha, beta, sin_a, sin_b, cos_a, cos_b, tan_b)
+    g2 = oren_nayar_interreflection(sig2, cos_dphi, beta)
+    return (
+        (p[0] / math.pi) * g1 + (p[0] * p[0] / math.pi) * g2,
+        (p[1] / math.pi) * g1 + (p[1] * p[1] / math.pi) * g2,
+        (p[2] / math.pi) * g1 + (p[2] * p[2] / math.pi) * g2,
+    )
 
 
 @register
@@ -129,35 +188,7 @@ class OrenNayar(BRDF):
         ),
     )
 
-    def _eval(self, wi, wo, p):
-        dt = wi.dtype.type
-        pi = dt(np.pi)
-        kd = p["kd"]
-        sig2 = p["sigma"] * p["sigma"]
-        si, ci, ti, cpi, spi = _angles(wi)
-        so, co, to, cpo, spo = _angles(wo)
-        cos_dphi = np.clip(cpi * cpo + spi * spo, dt(-1), dt(1))
-        sin_a = np.maximum(si, so)  # α = max(θi, θo): the larger sine, the smaller cosine
-        cos_a = np.minimum(ci, co)
-        sin_b = np.minimum(si, so)
-        cos_b = np.maximum(ci, co)
-        tan_b = sin_b / np.maximum(cos_b, dt(COS_FLOOR))
+    kernel = staticmethod(oren_nayar_kernel)
 
-        if p["variant"] == "qualitative":
-            A = dt(1) - dt(0.5) * sig2 / (sig2 + dt(0.33))
-            B = dt(0.45) * sig2 / (sig2 + dt(0.09))
-            g = A + B * np.maximum(cos_dphi, dt(0)) * sin_a * tan_b
-            return (kd / pi) * g[..., None]
-
-        alpha = np.maximum(ti, to)
-        beta = np.minimum(ti, to)
-        two_b_pi = dt(2) * beta / pi
-        C1 = dt(1) - dt(0.5) * sig2 / (sig2 + dt(0.33))
-        k2 = dt(0.45) * sig2 / (sig2 + dt(0.09))
-        C2 = np.where(cos_dphi >= 0, k2 * sin_a, k2 * (sin_a - two_b_pi**3))
-        C3 = dt(0.125) * sig2 / (sig2 + dt(0.09)) * (dt(4) * alpha * beta / (pi * pi)) ** 2
-        tan_half = (sin_a + sin_b) / np.maximum(cos_a + cos_b, dt(COS_FLOOR))
-        g1 = C1 + cos_dphi * C2 * tan_b + (dt(1) - np.abs(cos_dphi)) * C3 * tan_half
-        g1 = np.maximum(g1, dt(0))  # the fit dips below 0 for large σ, grazing, Δφ ≈ π
-        g2 = dt(0.17) * sig2 / (sig2 + dt(0.13)) * (dt(1) - cos_dphi * two_b_pi**2)
-        return (kd / pi) * g1[..., None] + (kd * kd / pi) * g2[..., None]
+    def kernel_args(self):
+        return self._pack(("kd", "sigma"), ("variant",))

@@ -49,8 +49,9 @@ normalized  bool    true     true | false  Lewis's (s+2)/(2π) form, else the ra
 
 from __future__ import annotations
 
-import numpy as np
+import math
 
+from ..engine import jit
 from ..params import Param, exponent_param, kd_param, ks_param
 from ..registry import register
 from .base import BRDF
@@ -69,18 +70,33 @@ def phong_family_spec(ks_doc: str, shininess_doc: str, normalized_doc: str) -> t
     )
 
 
-def phong_family_combine(lobe, wi, p, norm):
-    """kd/π + ks·lobe in the family's two forms: ``normalized`` scales the lobe by ``norm``;
-    the raw lighting-equation form divides it by cos θi (floored at :data:`NL_FLOOR`)."""
-    dt = wi.dtype.type
-    lobe = lobe * norm if p["normalized"] else lobe / np.maximum(wi[..., 2], dt(NL_FLOOR))
-    return p["kd"] / dt(np.pi) + p["ks"] * lobe[..., None]
+@jit
+def phong_family_lobe(lobe, wiz, normalized, norm):
+    """The family's two forms of the lobe: ``normalized`` scales it by ``norm``; the raw
+    lighting-equation form divides it by cos θi (floored at :data:`NL_FLOOR`)."""
+    if normalized:
+        return lobe * norm
+    return lobe / max(wiz, NL_FLOOR)
 
 
-def _cos_power(x, s):
+@jit
+def cos_power(x, s):
     """``max(0, x)^s`` with 0 (not 1) where ``x <= 0``, also for ``s = 0``."""
-    pos = x > 0
-    return np.where(pos, np.power(np.where(pos, x, 1), s), 0)
+    if x <= 0.0:
+        return 0.0
+    return x ** s
+
+
+@jit
+def phong_kernel(wix, wiy, wiz, wox, woy, woz, p, c):
+    """kd/π + ks·lobe, lobe = (r·wo)^s with r = reflect(wi) about +z; Lewis's (s+2)/(2π) or raw/(n·wi).
+
+    ``p = [kd(3), ks(3), shininess]``, ``c = [normalized]``.
+    """
+    rv = min(wiz * woz - wix * wox - wiy * woy, 1.0)  # r·wo
+    s = p[6]
+    lobe = phong_family_lobe(cos_power(rv, s), wiz, c[0], (s + 2.0) / (2.0 * math.pi))
+    return p[0] / math.pi + p[3] * lobe, p[1] / math.pi + p[4] * lobe, p[2] / math.pi + p[5] * lobe
 
 
 @register
@@ -99,10 +115,7 @@ class Phong(BRDF):
         "false: the lighting-equation term divided by cos θi (neither)",
     )
 
-    def _eval(self, wi, wo, p):
-        dt = wi.dtype.type
-        # r = reflect(wi) about +z; r·wo
-        rv = wi[..., 2] * wo[..., 2] - wi[..., 0] * wo[..., 0] - wi[..., 1] * wo[..., 1]
-        s = p["shininess"]
-        lobe = _cos_power(np.minimum(rv, dt(1)), s)
-        return phong_family_combine(lobe, wi, p, (s + dt(2)) / dt(2 * np.pi))
+    kernel = staticmethod(phong_kernel)
+
+    def kernel_args(self):
+        return self._pack(("kd", "ks", "shininess"), ("normalized",))

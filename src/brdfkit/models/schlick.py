@@ -49,10 +49,13 @@ Verification (formula audit; the paper's own text was not available to us):
   the tangent +x (so p → 0 gives scratches along +x), as LuxCore does for a
   positive anisotropy; RISE measures it from its second tangent. The paper's
   choice of reference axis could not be checked; it only swaps x and y.
-* NOT verified: the a/b/c split (b = 4r(1 − r), a or c = 1 − b). None of the
-  sources available to us states it; it is as the previous author recalled
-  it from the paper, and the auditor recalls the same form, but no document
-  confirms it.
+* the a/b/c split (b = 4r(1 − r), a = 0, c = 1 − b for r < 0.5 and a = 1 − b,
+  c = 0 otherwise): LuxCoreRender does not state it (its Schlick material has
+  the Z, A, G factors only), but it has an independent source: the renderer
+  OpalFalcon, named by the comparison with independent implementations
+  (issue 14) as stating this split. It is also what the previous author and
+  the auditor both recalled from the paper; not checked against the paper's
+  own text.
 
 Material types:
 
@@ -69,17 +72,18 @@ What ``eval`` returns and what it does not:
   :meth:`Schlick.mirror_reflectance` gives the delta's weight (the fraction of
   light from wi sent into reflect(wi)): c·S(cos θi), plus (1 − S)·S'·c' for
   the double slab.
-* The paper also has a term that re-injects the energy lost to
-  self-shadowing, weighted by 1 − G(v)G(v'). Its exact form stays
-  unresolved, so it is **not** implemented. The sources disagree: the
-  third-party digest writes D = G G' Z A/(4π v v') + (1 − G G')/(4π v v'),
-  whose second term alone has the albedo (1/(4π v))∫(1 − G(v)G(v'))dω',
-  which grows like 1/(2v) at grazing incidence (hardly what a paper that
-  claims energy conservation would propose, so possibly a transcription
-  slip); LuxCoreRender's optional "multibounce" term, which its source
-  calls an "alternative", is clamp((1 − G G')/(4 v v'), 0, 1), without π;
-  and the auditor recalls (1 − G G')/π, a Lambertian lobe, without a
-  document to confirm it.
+* ``reinjection`` (default false) adds the paper's re-injection of the
+  energy lost to self-shadowing, as best reconstructed: the glossy part
+  becomes ``b·[G(v)G(v')·Z(t)·A(w) + 1 − G(v)G(v')]/(4π v v')``, the form
+  the third-party digest writes (the weight b of the glossy part applies to
+  both terms). The sources disagree on this term — LuxCoreRender's optional
+  "multibounce" alternative is clamp((1 − G G')/(4 v v'), 0, 1) without π;
+  the auditor recalls a Lambertian (1 − G G')/π — and the paper's text was
+  not available to settle it. **Its albedo exceeds 1 at grazing incidence**:
+  the extra term alone grows like 1/(2v). Measured (color = 1, p = 1, mirror
+  part included, ``brdfkit.analysis.albedo``): r = 0.05: 1.00 at θ = 0°..60°,
+  1.14 at 80°, 1.47 at 85°, 5.3 at 89°; r = 0.5: 0.64 at 0°, 1.03 at 60°,
+  2.8 at 80°, 28.5 at 89°. Still reciprocal (symmetric in v, v').
 
 Properties: every factor is symmetric in wi and wo (u, t, w, and the product
 G(v)G(v')), so the model is reciprocal. Energy: Z/π is a normalised
@@ -91,11 +95,23 @@ r ∈ {0.05, 0.3, 0.5, 0.8} and p ∈ {1, 0.3}, but 1.014 at θi = 85° and 1.12
 at 89° for r = 0.05 — not strictly energy conserving at grazing incidence.
 r = 1 with color = 1 is exactly Lambert (albedo 1).
 
-Numerics: the glossy term is evaluated as
-Z A / (4π (r + (1−r) v)(r + (1−r) v')) (G(v)/v simplified), and Z's
-denominator as (hx² + hy²) + r t² (no cancellation for t → 1 and small r),
-so it is finite and accurate for every direction: no floors are needed.
-At h = n the azimuth w is undefined and A is taken as 1.
+Numerics (guarded for every parameter down to the smallest positive float
+and at the exact range edges, float32 and float64): with ``d = r + (1 − r)v``
+(= v/G(v)) and ``q = r/(s2 + r t²)`` (Z's denominator with 1 − t² = s2 =
+hx² + hy², so no cancellation for t → 1), the glossy part is evaluated as
+``(1 − r)/π · A · (q/d)(q/d')`` — the same as b·Z·A·G G'/(4π v v') since
+b·Z = 4(1 − r) q² — so neither Z = 1/r (at h = n) nor r² is ever formed; q ≤ 2
+everywhere. (Before this guard r = 1e-170 gave Inf, and float32 failed from
+r ≈ 1e-19.) A is evaluated as ``hypot(hx, hy)/hypot(√p·hy, hx/√p)``, which
+never squares p (1/sqrt(p) at w = 0 for tiny p instead of p/0); at h = n w is
+undefined and A is taken as 1. d and d' are floored at 1e-300 (which only
+matters when r and v are both below it), and each slab's directional factor is
+capped at 1e300 (:data:`SLAB_CAP`): a near-mirror slab (r → 0) lit and seen at
+grazing incidence has a true value beyond any float, and the cap keeps it finite
+(never NaN: no factor is 0 where another is infinite). The kernel computes in
+float64 for float32 input too; the engine rounds once and clamps to float32's
+largest value. The GLSL twin (float32 throughout) floors d at 1e-18, caps each
+slab at 8.5e37 and clamps r, p at 1e-37 (GL may flush subnormal uniforms to 0).
 
 A(w) is largest for w = 0, i.e. for half vectors tilted toward ±y: with
 p < 1 the facets are scratches along the tangent +x and the highlight is
@@ -111,21 +127,32 @@ p          scalar  1        (0, 1]           isotropy (1 isotropic, → 0 scratc
 color2     rgb     0.5      [0, 1]           C' of the lower slab (double only)
 r2         scalar  1        (0, 1]           roughness of the lower slab (double only)
 p2         scalar  1        (0, 1]           isotropy of the lower slab (double only)
+reinjection bool   false    true | false     add b·(1 − G G')/(4π v v'), the re-injected light
 =========  ======  =======  ===============  ==================================================
 """
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
-from ..geometry import half_vector
+from ..engine import jit
+from ..geometry import dot3, half_vector_c
 from ..params import Param
 from ..registry import register
-from ..terms.fresnel import fresnel_schlick
+from ..terms.fresnel import f_schlick, fresnel_schlick
 from .base import BRDF
 
+#: cap on one slab's directional factor: a near-mirror slab (r → 0) at grazing incidence has a
+#: true value beyond any float; capped, S·D and the double slab's sum stay finite (never 0·∞)
+SLAB_CAP = 1e300
+#: floor on d = r + (1 − r) v: only reached when r and v are both below it
+D_FLOOR = 1e-300
 
-def split_weights(r: float) -> tuple[float, float, float]:
+
+@jit
+def split_weights(r):
     """Schlick's Lambertian / glossy / mirror fractions ``(a, b, c)`` for roughness ``r``."""
     b = 4.0 * r * (1.0 - r)
     if r < 0.5:
@@ -133,32 +160,95 @@ def split_weights(r: float) -> tuple[float, float, float]:
     return 1.0 - b, b, 0.0
 
 
-def _half_terms(wi, wo):
-    """``(t, s2, u, w2, at_n)``: n·h, 1 − (n·h)² (from hx² + hy², no cancellation), h·wi,
-    w² = cos² of h's azimuth from +x, and ``h == n``."""
-    h = half_vector(wi, wo)
-    t = h[..., 2]
-    u = np.clip(np.einsum("...i,...i->...", wi, h), 0, 1)
-    s2 = h[..., 0] ** 2 + h[..., 1] ** 2
-    at_n = s2 == 0
-    w2 = np.where(at_n, 1, h[..., 0] ** 2 / np.where(at_n, 1, s2))
-    return np.clip(t, 0, 1), s2, u, w2, at_n
+@jit
+def zenith_ratio(t, s2, r):
+    """``q = r/((1 − t²) + r t²)``, so that ``b·Z(t) = 4(1 − r)·q²`` (Z = r/(1 + r t² − t²)²).
+
+    Written with ``1 − t² = s2 = hx² + hy²``. q ≤ 2 for every h (s2 + t² = 1), and the
+    denominator never vanishes (s2 = 0 means t = 1), so neither r² nor Z itself is formed:
+    Z = 1/r at h = n overflows for r < 1e-308 and r² underflows for r < 1e-154 (Inf, NaN
+    before this guard).
+    """
+    return r / (s2 + r * t * t)
 
 
-def _slab_directional(t, s2, w2, at_n, v, v2, r, p, dt):
-    """One slab's directional factor without the mirror part: a/π + b·G G' Z A/(4π v v')."""
-    a, b, _ = split_weights(float(r))
-    pi = dt(np.pi)
-    # 1 + r t² − t² = (1 − t²) + r t², with 1 − t² = hx² + hy² (accurate for t → 1, small r)
-    Z = r / (s2 + r * t * t) ** 2
-    if p == 1:
-        A = np.ones_like(t)
-    else:
-        # w is undefined at h = n: take the isotropic value 1 there
-        A = np.where(at_n, dt(1), np.sqrt(p / (p * p - p * p * w2 + w2)))
-    # G(v)G(v')/(v v') = 1/((r + (1-r) v)(r + (1-r) v'))
-    gg = dt(1) / ((r + (dt(1) - r) * v) * (r + (dt(1) - r) * v2))
-    return dt(a) / pi + dt(b) * Z * A * gg / (dt(4) * pi)
+@jit
+def azimuth_factor(hx, hy, p):
+    """Schlick's A(w) = sqrt(p/(p² − p² w² + w²)), w = hx/sqrt(hx² + hy²), 1 at h = n.
+
+    Evaluated as ``hypot(hx, hy)/hypot(sqrt(p)·hy, hx/sqrt(p))`` (the same expression, since
+    p²(1 − w²) + w² = ((p hy)² + hx²)/(hx² + hy²)): p is never squared nor multiplied into a
+    subnormal, so p down to the smallest positive float gives the finite 1/sqrt(p) at w = 0
+    instead of p/0, to full precision.
+    """
+    if p == 1.0:
+        return 1.0
+    sp = math.sqrt(p)
+    den = math.hypot(sp * hy, hx / sp)
+    if den == 0.0:  # only at hx = hy = 0 (h = n): A is undefined there, take 1
+        return 1.0
+    return math.hypot(hx, hy) / den
+
+
+@jit
+def reinjection(v, v2, r):
+    """The re-injected light ``b·(1 − G(v)G(v'))/(4π v v')`` (b = 4r(1 − r)), without cancellation.
+
+    ``1 − G G' = r·B/(d d')`` with ``d = r + (1 − r) v`` and
+    ``B = r + (1 − r)(v + v') − (2 − r) v v'`` (≥ 0, 0 at v = v' = 1), so the term is
+    ``(1 − r)/π · (r/(d v)) · (r/(d' v')) · B``. Each ``r/(d v)`` lies in [r, ∞] (d, v ≤ 1),
+    so their product is never 0·∞ and b/(4π) is never formed (it underflows for tiny r).
+    """
+    B = max(r + (1.0 - r) * (v + v2) - (2.0 - r) * v * v2, 0.0)
+    x1 = r / max(r + (1.0 - r) * v, D_FLOOR) / v
+    x2 = r / max(r + (1.0 - r) * v2, D_FLOOR) / v2
+    return (1.0 - r) / math.pi * (x1 * x2) * B
+
+
+@jit
+def slab_directional(t, s2, hx, hy, v, v2, r, p, reinject):
+    """One slab's directional factor without the mirror part: a/π + b·G G' Z A/(4π v v')
+    [+ b·(1 − G G')/(4π v v') with ``reinject``], capped at :data:`SLAB_CAP`.
+
+    b·Z·A·G G'/(4π v v') = (1 − r)/π · A · (q/d)(q/d') with d = r + (1 − r)v = v/G(v)
+    and q from :func:`zenith_ratio`.
+    """
+    a, b, _ = split_weights(r)
+    f = a / math.pi
+    if b > 0.0:
+        q = zenith_ratio(t, s2, r)
+        d1 = max(r + (1.0 - r) * v, D_FLOOR)
+        d2 = max(r + (1.0 - r) * v2, D_FLOOR)
+        f += (1.0 - r) / math.pi * azimuth_factor(hx, hy, p) * (q / d1) * (q / d2)
+        if reinject:
+            f += reinjection(v, v2, r)
+    return min(f, SLAB_CAP)
+
+
+@jit
+def schlick_kernel(wix, wiy, wiz, wox, woy, woz, p, c):
+    """Schlick 1994, one or two slabs, per pair (engine protocol, :mod:`brdfkit.engine`).
+
+    ``p`` = [color (3), r, p, color2 (3), r2, p2]; ``c`` = [layers (0 single, 1 double), reinjection].
+    """
+    hx, hy, hz = half_vector_c(wix, wiy, wiz, wox, woy, woz)
+    t = min(max(hz, 0.0), 1.0)
+    s2 = hx * hx + hy * hy
+    u = min(max(dot3(wix, wiy, wiz, hx, hy, hz), 0.0), 1.0)
+    rein = c[1] != 0
+    D = slab_directional(t, s2, hx, hy, wiz, woz, p[3], p[4], rein)
+    S0 = f_schlick(p[0], u)
+    S1 = f_schlick(p[1], u)
+    S2 = f_schlick(p[2], u)
+    r0 = S0 * D
+    r1 = S1 * D
+    r2 = S2 * D
+    if c[0] == 1:
+        D2 = slab_directional(t, s2, hx, hy, wiz, woz, p[8], p[9], rein)
+        r0 += (1.0 - S0) * f_schlick(p[5], u) * D2
+        r1 += (1.0 - S1) * f_schlick(p[6], u) * D2
+        r2 += (1.0 - S2) * f_schlick(p[7], u) * D2
+    return r0, r1, r2
 
 
 @register
@@ -190,20 +280,20 @@ class Schlick(BRDF):
         Param("color2", "rgb", 0.5, (0.0, 1.0), "", "C' of the lower slab (layers=double only)"),
         Param("r2", "scalar", 1.0, (0.0, 1.0), "", "roughness of the lower slab (layers=double only)", open_lo=True),
         Param("p2", "scalar", 1.0, (0.0, 1.0), "", "isotropy of the lower slab (layers=double only)", open_lo=True),
+        Param(
+            "reinjection",
+            "bool",
+            False,
+            doc="add the paper's re-injection of the light lost to self-shadowing, b·(1 − G G')/(4π v v') "
+            "(as reconstructed; its albedo exceeds 1 at grazing incidence)",
+            fit=False,
+        ),
     )
 
-    def _eval(self, wi, wo, p):
-        dt = wi.dtype.type
-        t, s2, u, w2, at_n = _half_terms(wi, wo)
-        v, v2 = wi[..., 2], wo[..., 2]
-        S = fresnel_schlick(p["color"], u[..., None])
-        D = _slab_directional(t, s2, w2, at_n, v, v2, p["r"], p["p"], dt)[..., None]
-        f = S * D
-        if p["layers"] == "double":
-            S2 = fresnel_schlick(p["color2"], u[..., None])
-            D2 = _slab_directional(t, s2, w2, at_n, v, v2, p["r2"], p["p2"], dt)[..., None]
-            f = f + (dt(1) - S) * S2 * D2
-        return f
+    kernel = staticmethod(schlick_kernel)
+
+    def kernel_args(self):
+        return self._pack(("color", "r", "p", "color2", "r2", "p2"), ("layers", "reinjection"))
 
     def delta_reflectance(self, w) -> np.ndarray:
         """The ideal-mirror part (see :meth:`mirror_reflectance`), for albedo and energy checks."""

@@ -49,17 +49,161 @@ never produce NaN: Beckmann via ``erfc``, GGX as
 Numerics of D
 -------------
 The exponent ``tan²θ/α²`` can be huge (small α, grazing h) while ``cos⁴θ``
-underflows; D is evaluated as ``exp(−e − 4 ln h_z)`` so that it underflows to 0
-instead of becoming ``0/0`` or ``inf/inf``, in float32 as in float64. For
-``h_z <= 0`` every D here returns 0.
+underflows; the scalar sources compute in float64 and return 0 where ``h_z⁴``
+underflows (the exponential is 0 there already), so D is never ``0/0`` or
+``inf/inf``, for float32 as for float64 results. For ``h_z <= 0`` every D here
+returns 0.
+
+One source per formula
+----------------------
+Each formula is written once, as a scalar function in component form
+(``d_ggx(hx, hy, hz, ax, ay)``, ``lambda_beckmann(wx, wy, wz, ax, ay)``),
+compiled by :func:`brdfkit.engine.jit` and called by the model kernels; the
+array functions (``ggx(h, ax, ay)``, ``beckmann_lambda(w, ax, ay)``, ...) are
+thin wrappers that apply the same scalar source element-wise
+(:class:`brdfkit.engine.vectorize`). They return the dtype of the direction
+argument (float32 stays float32: computed in float64, rounded once).
 """
 
 from __future__ import annotations
 
-import numpy as np
-from scipy.special import erfc
+import math
 
-_SQRT_PI = np.sqrt(np.pi)
+import numpy as np
+
+from ..engine import jit, vectorize
+
+_SQRT_PI = math.sqrt(math.pi)
+
+# ------------------------------------------------------------ scalar sources
+
+
+@jit
+def slope2(hx, hy, ax, ay):
+    """``h_x²/α_x² + h_y²/α_y²`` (= tan²θ_h/α(h)² · h_z²)."""
+    u = hx / ax
+    v = hy / ay
+    return u * u + v * v
+
+
+@jit
+def d_beckmann_slopes(hx, hy, hz, ax, ay):
+    """Beckmann D without the 1/π: ``exp(−(h_x²/α_x² + h_y²/α_y²)/h_z²) / (α_x α_y h_z⁴)``.
+
+    Cook & Torrance (1982, eq. 4) for α_x = α_y = m. 0 for ``h_z <= 0``, and 0
+    where ``h_z⁴`` underflows (the exponential has underflowed long before: for
+    α ≤ 1 and h_z < 1e-70, e > 1e140), so never 0/0.
+    """
+    hz2 = hz * hz
+    hz4 = hz2 * hz2
+    if hz <= 0.0 or hz4 <= 0.0:
+        return 0.0
+    e = slope2(hx, hy, ax, ay) / hz2
+    return math.exp(-e) / (ax * ay * hz4)
+
+
+@jit
+def d_beckmann(hx, hy, hz, ax, ay):
+    """Normalised Beckmann D (Walter et al. 2007, eq. 25; anisotropic: Heitz 2014, eq. 71)."""
+    return d_beckmann_slopes(hx, hy, hz, ax, ay) / math.pi
+
+
+@jit
+def d_beckmann_cook(cos_h, m):
+    """Cook & Torrance's (1982, eq. 4) ``exp(−(tan α/m)²)/(m² cos⁴α)`` from ``cos α``; 0 for ``cos α <= 0``."""
+    c = min(cos_h, 1.0)
+    c2 = c * c
+    c4 = c2 * c2
+    if c <= 0.0 or c4 <= 0.0:
+        return 0.0  # the exponential has underflowed long before cos⁴α does (m ≤ 1)
+    t2 = (1.0 - c2) / c2
+    return math.exp(-t2 / (m * m)) / (m * m * c4)
+
+
+@jit
+def d_ggx(hx, hy, hz, ax, ay):
+    """GGX / Trowbridge-Reitz ``1/(π α_x α_y (h_x²/α_x² + h_y²/α_y² + h_z²)²)`` (Walter 2007, eq. 33; Heitz 2014, eq. 85)."""
+    if hz <= 0.0:
+        return 0.0
+    q = slope2(hx, hy, ax, ay) + hz * hz  # >= 1 for a unit h and α <= 1
+    den = math.pi * ax * ay * q * q
+    if den <= 0.0:
+        return math.inf  # only for a non-unit, vanishing h (never from a kernel)
+    return 1.0 / den
+
+
+@jit
+def projected_slope(wx, wy, ax, ay):
+    """``s = sqrt(w_x² α_x² + w_y² α_y²)``, so that ``α(w) tan θ = s / w_z`` (Heitz 2014, eq. 80)."""
+    u = wx * ax
+    v = wy * ay
+    return math.sqrt(u * u + v * v)
+
+
+@jit
+def lambda_beckmann(wx, wy, wz, ax, ay):
+    """Exact Smith Λ of Beckmann: ``a = w_z/s``, ``Λ = (exp(−a²)/(a√π) − erfc(a))/2`` (Walter 2007, eq. 27; Heitz 2014, eq. 72).
+
+    0 at normal incidence (s = 0), +inf for ``w_z <= 0``, never NaN or negative.
+    """
+    if wz <= 0.0:
+        return math.inf
+    s = projected_slope(wx, wy, ax, ay)
+    if s <= 0.0:
+        return 0.0
+    a = wz / s
+    den = a * _SQRT_PI
+    if den <= 0.0:
+        return math.inf  # a underflowed (w_z ~ 5e-324): fully masked, G1 = 0
+    lam = 0.5 * (math.exp(-a * a) / den - math.erfc(a))
+    return max(lam, 0.0)
+
+
+@jit
+def lambda_ggx(wx, wy, wz, ax, ay):
+    """Exact Smith Λ of GGX, ``(−1 + sqrt(1 + s²/w_z²))/2`` as ``s²/(2 w_z (sqrt(w_z² + s²) + w_z))`` (Walter 2007, eq. 34).
+
+    0 at normal incidence, +inf for ``w_z <= 0``; no cancellation.
+    """
+    if wz <= 0.0:
+        return math.inf
+    s = projected_slope(wx, wy, ax, ay)
+    den = 2.0 * wz * (math.sqrt(wz * wz + s * s) + wz)
+    if den <= 0.0:
+        return math.inf  # the denominator underflowed (w_z ~ 5e-324 at small α): fully masked, G1 = 0
+    return (s * s) / den
+
+
+#: ``distribution`` choice indices used by the kernels (the order of microfacet's ``choices``)
+BECKMANN = 0
+GGX = 1
+
+
+@jit
+def d_of(dist, hx, hy, hz, ax, ay):
+    """The normalised D of distribution index ``dist`` (:data:`BECKMANN` or :data:`GGX`)."""
+    if dist == 0:
+        return d_beckmann(hx, hy, hz, ax, ay)
+    return d_ggx(hx, hy, hz, ax, ay)
+
+
+@jit
+def lambda_of(dist, wx, wy, wz, ax, ay):
+    """The Smith Λ of distribution index ``dist``."""
+    if dist == 0:
+        return lambda_beckmann(wx, wy, wz, ax, ay)
+    return lambda_ggx(wx, wy, wz, ax, ay)
+
+
+# ------------------------------------------------------ array API (wrappers)
+
+_v_beckmann = vectorize(d_beckmann, 5)
+_v_beckmann_slopes = vectorize(d_beckmann_slopes, 5)
+_v_beckmann_cook = vectorize(d_beckmann_cook, 2)
+_v_ggx = vectorize(d_ggx, 5)
+_v_slope = vectorize(projected_slope, 4)
+_v_lambda_beckmann = vectorize(lambda_beckmann, 5)
+_v_lambda_ggx = vectorize(lambda_ggx, 5)
 
 
 def _dtype_of(x):
@@ -71,18 +215,9 @@ def _dtype_of(x):
 def _split(h, alpha_x, alpha_y):
     h = np.asarray(h)
     dt = _dtype_of(h)
-    h = h.astype(dt, copy=False)
-    ax = np.asarray(alpha_x, dtype=dt)
-    ay = ax if alpha_y is None else np.asarray(alpha_y, dtype=dt)
+    ax = np.asarray(alpha_x, dtype=np.float64)
+    ay = ax if alpha_y is None else np.asarray(alpha_y, dtype=np.float64)
     return h[..., 0], h[..., 1], h[..., 2], ax, ay, dt
-
-
-def _slope2(hx, hy, ax, ay):
-    """``h_x²/α_x² + h_y²/α_y²`` (= tan²θ_h/α(h)² · h_z²)."""
-    return (hx / ax) ** 2 + (hy / ay) ** 2
-
-
-# --------------------------------------------------------------------------- D
 
 
 def beckmann(h, alpha_x, alpha_y=None, normalized=True):
@@ -94,16 +229,11 @@ def beckmann(h, alpha_x, alpha_y=None, normalized=True):
     the tangent +x. ``normalized=False`` omits the 1/π, which gives the
     Cook-Torrance (1982) / lecture form (see :func:`beckmann_cook`).
     Returns 0 for ``h_z <= 0``; underflows to 0 (never NaN/Inf) for tiny ``h_z``.
+    Scalar source: :func:`d_beckmann`, :func:`d_beckmann_slopes`.
     """
     hx, hy, hz, ax, ay, dt = _split(h, alpha_x, alpha_y)
-    up = hz > 0
-    hz_s = np.where(up, hz, dt.type(1))
-    with np.errstate(over="ignore", divide="ignore", under="ignore", invalid="ignore"):
-        e = _slope2(hx, hy, ax, ay) / (hz_s * hz_s)
-        d = np.exp(-e - dt.type(4) * np.log(hz_s)) / (ax * ay)
-    if normalized:
-        d = d / dt.type(np.pi)
-    return np.where(up, d, dt.type(0))
+    f = _v_beckmann if normalized else _v_beckmann_slopes
+    return f(hx, hy, hz, ax, ay, dtype=dt)
 
 
 def beckmann_cook(cos_h, m):
@@ -112,18 +242,9 @@ def beckmann_cook(cos_h, m):
     ``D = exp(−(tan α/m)²) / (m² cos⁴ α)`` — no 1/π; ``∫ D cos α dω = π``.
     ``tan² α`` is formed as ``(1 − cos²α)/cos²α`` (for half vectors prefer
     ``beckmann(h, m, normalized=False)``, which uses ``h_x, h_y`` and is more
-    accurate near the peak in float32). Returns 0 for ``cos α <= 0``.
+    accurate near the peak). Returns 0 for ``cos α <= 0``. Scalar source: :func:`d_beckmann_cook`.
     """
-    c = np.asarray(cos_h)
-    dt = _dtype_of(c)
-    c = np.clip(c.astype(dt, copy=False), dt.type(-1), dt.type(1))
-    m = np.asarray(m, dtype=dt)
-    up = c > 0
-    cs = np.where(up, c, dt.type(1))
-    with np.errstate(over="ignore", divide="ignore", under="ignore", invalid="ignore"):
-        t2 = (dt.type(1) - cs * cs) / (cs * cs)
-        d = np.exp(-t2 / (m * m) - dt.type(4) * np.log(cs)) / (m * m)
-    return np.where(up, d, dt.type(0))
+    return _v_beckmann_cook(cos_h, m, dtype=_dtype_of(cos_h))
 
 
 def ggx(h, alpha_x, alpha_y=None):
@@ -131,13 +252,10 @@ def ggx(h, alpha_x, alpha_y=None):
 
     ``D = 1 / (π α_x α_y (h_x²/α_x² + h_y²/α_y² + h_z²)²)`` (Trowbridge & Reitz
     1975; Walter et al. 2007, eq. 33; anisotropic: Heitz 2014, eq. 85).
-    ``alpha_y=None`` means isotropic. Returns 0 for ``h_z <= 0``.
+    ``alpha_y=None`` means isotropic. Returns 0 for ``h_z <= 0``. Scalar source: :func:`d_ggx`.
     """
     hx, hy, hz, ax, ay, dt = _split(h, alpha_x, alpha_y)
-    with np.errstate(over="ignore", under="ignore"):
-        q = _slope2(hx, hy, ax, ay) + hz * hz
-        d = dt.type(1) / (dt.type(np.pi) * ax * ay * q * q)
-    return np.where(hz > 0, d, dt.type(0))
+    return _v_ggx(hx, hy, hz, ax, ay, dtype=dt)
 
 
 def _cos_to_h(cos_h):
@@ -158,17 +276,14 @@ def ggx_iso(cos_h, alpha):
     return ggx(_cos_to_h(cos_h), alpha)
 
 
-# ---------------------------------------------------------------------- Smith Λ
-
-
 def projected_roughness_tan(w, alpha_x, alpha_y=None):
     """``(s, w_z)`` with ``s = sqrt(w_x² α_x² + w_y² α_y²)``, so ``α(w) tan θ = s / w_z``.
 
     ``α(w) = sqrt(α_x² cos²φ + α_y² sin²φ)`` is the roughness of the 1-D slope
-    distribution seen along the azimuth of ``w`` (Heitz 2014, eq. 80).
+    distribution seen along the azimuth of ``w`` (Heitz 2014, eq. 80). Scalar source: :func:`projected_slope`.
     """
     wx, wy, wz, ax, ay, dt = _split(w, alpha_x, alpha_y)
-    return np.sqrt((wx * ax) ** 2 + (wy * ay) ** 2), wz
+    return _v_slope(wx, wy, ax, ay, dtype=dt), wz.astype(dt, copy=False)
 
 
 def beckmann_lambda(w, alpha_x, alpha_y=None):
@@ -178,16 +293,10 @@ def beckmann_lambda(w, alpha_x, alpha_y=None):
     ``Λ = (erf(a) − 1)/2 + exp(−a²)/(2 a √π) = (exp(−a²)/(a √π) − erfc(a))/2``
     (Walter et al. 2007, eq. 27 with G1 = 1/(1+Λ); Heitz 2014, eq. 72).
     Λ = 0 at normal incidence, +inf for ``w_z <= 0`` (G1 = 0 there); never NaN.
+    Scalar source: :func:`lambda_beckmann`.
     """
-    s, wz = projected_roughness_tan(w, alpha_x, alpha_y)
-    dt = s.dtype
-    up = wz > 0
-    with np.errstate(over="ignore", divide="ignore", under="ignore", invalid="ignore"):
-        a = np.where(up, wz, dt.type(1)) / s  # s == 0 -> a = inf -> Λ = 0
-        lam = dt.type(0.5) * (np.exp(-a * a) / (a * dt.type(_SQRT_PI)) - erfc(a).astype(dt, copy=False))
-    lam = np.where(np.isnan(lam), dt.type(0), lam)  # a = inf gives 0/inf - 0 = 0 already; belt and braces
-    lam = np.maximum(lam, dt.type(0))
-    return np.where(up, lam, dt.type(np.inf))
+    wx, wy, wz, ax, ay, dt = _split(w, alpha_x, alpha_y)
+    return _v_lambda_beckmann(wx, wy, wz, ax, ay, dtype=dt)
 
 
 def ggx_lambda(w, alpha_x, alpha_y=None):
@@ -196,15 +305,10 @@ def ggx_lambda(w, alpha_x, alpha_y=None):
     ``Λ = (−1 + sqrt(1 + α(w)² tan²θ))/2``, evaluated as
     ``s² / (2 w_z (sqrt(w_z² + s²) + w_z))`` with ``s = α(w) tan θ · w_z``
     (Walter et al. 2007, eq. 34; Heitz 2014, eq. 86). Λ = 0 at normal incidence,
-    +inf for ``w_z <= 0``; never NaN.
+    +inf for ``w_z <= 0``; never NaN. Scalar source: :func:`lambda_ggx`.
     """
-    s, wz = projected_roughness_tan(w, alpha_x, alpha_y)
-    dt = s.dtype
-    up = wz > 0
-    wz_s = np.where(up, wz, dt.type(1))
-    with np.errstate(over="ignore", divide="ignore", under="ignore", invalid="ignore"):
-        lam = (s * s) / (dt.type(2) * wz_s * (np.sqrt(wz_s * wz_s + s * s) + wz_s))
-    return np.where(up, lam, dt.type(np.inf))
+    wx, wy, wz, ax, ay, dt = _split(w, alpha_x, alpha_y)
+    return _v_lambda_ggx(wx, wy, wz, ax, ay, dtype=dt)
 
 
 def beckmann_lambda_iso(cos_t, alpha):
@@ -233,6 +337,18 @@ def distribution(name):
 
 
 __all__ = [
+    "slope2",
+    "d_beckmann_slopes",
+    "d_beckmann",
+    "d_beckmann_cook",
+    "d_ggx",
+    "projected_slope",
+    "lambda_beckmann",
+    "lambda_ggx",
+    "d_of",
+    "lambda_of",
+    "BECKMANN",
+    "GGX",
     "beckmann",
     "beckmann_cook",
     "beckmann_iso",

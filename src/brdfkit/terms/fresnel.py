@@ -16,31 +16,116 @@ the axis; the functions themselves are plain elementwise numpy.
 * :func:`fresnel_schlick` — Schlick's (1994) approximation
   ``F0 + (1 − F0)(1 − c)⁵``.
 * :func:`f0_from_ior` — normal-incidence reflectance ``((n−1)/(n+1))²``.
+
+Each formula is written once as a scalar function (``f_dielectric(c, n)``,
+``f_conductor(c, eta, k)``, ``f_schlick(f0, c)``), compiled by
+:func:`brdfkit.engine.jit` for the model kernels; the array functions are thin
+element-wise wrappers over the same source (:class:`brdfkit.engine.vectorize`).
 """
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
+
+from ..engine import jit, vectorize
+
+# ------------------------------------------------------------ scalar sources
+
+
+@jit
+def f_dielectric(c, n):
+    """Exact dielectric Fresnel in Cook & Torrance's (1982, eq. 8) form, relative index ``n``, ``c = v·h``.
+
+    ``F = ½ (g−c)²/(g+c)² · (1 + (c(g+c)−1)²/(c(g−c)+1)²)``, ``g² = n² + c² − 1``;
+    1 under total internal reflection (g² < 0), 0 for the non-interface n = 1 at c = 0.
+    """
+    c = min(max(c, 0.0), 1.0)
+    d = n * n - 1.0
+    g2 = d + c * c
+    if g2 < 0.0:
+        return 1.0
+    # for n >= 1, g = hypot(sqrt(n² − 1), c) so that c² cannot underflow away
+    if d >= 0.0:
+        g = math.hypot(math.sqrt(d), c)
+    else:
+        g = math.sqrt(g2)
+    gc = g + c
+    if gc == 0.0:
+        return 0.0
+    a = (g - c) / gc
+    num = c * gc - 1.0
+    den = c * (g - c) + 1.0  # > 0 for c in [0, 1] unless n == 0
+    q = num / den
+    F = 0.5 * a * a * (1.0 + q * q)
+    return min(max(F, 0.0), 1.0)
+
+
+@jit
+def f_conductor(c, eta, k):
+    """Exact unpolarised Fresnel of a conductor, complex index ``η = eta + i·k``, at ``c = cos θ``.
+
+    Born & Wolf §14.2 with ``g = sqrt(η² − 1 + c²)`` (Im g ≥ 0);
+    ``|r_s| = |η² − 1|/|c + g|²``, ``|r_p| = |η² − 1| |(η² + 1)c² − 1|/|η²c + g|²``,
+    ``F = (|r_s|² + |r_p|²)/2``: no cancellation, exact 0 for an index-1
+    "interface", accurate for eta near 1 (see :func:`fresnel_conductor`).
+    """
+    c = min(max(c, 0.0), 1.0)
+    m1 = (eta - 1.0) * (eta + 1.0) - k * k  # Re(η² − 1)
+    Q = 2.0 * eta * k  # Im η² (>= 0)
+    # moduli as sqrt(x² + y²), not hypot: computed in float64 from bounded parameters
+    # (eta ≤ 10, k ≤ 20), the squares neither overflow nor underflow to a wrong result,
+    # and sqrt is an LLVM intrinsic that the compiler hoists and vectorises (hypot is a libm call)
+    qa = math.sqrt(m1 * m1 + Q * Q)  # |η² − 1|
+    c2 = c * c
+    A = m1 + c2  # Re g²
+    mod = math.sqrt(A * A + Q * Q)  # |g²|
+    big = math.sqrt(0.5 * (mod + abs(A)))  # the larger of Re g, Im g
+    small = 0.5 * abs(Q) / big if big > 0.0 else 0.0
+    if A >= 0.0:
+        u = big
+        v = small
+    else:
+        u = small
+        v = big
+    ds = (c + u) * (c + u) + v * v  # |c + g|²
+    t = (m1 + 1.0) * c + u
+    w = Q * c + v
+    dp = t * t + w * w  # |η² c + g|²
+    if ds == 0.0 or dp == 0.0:
+        return 0.0
+    rs = qa / ds
+    br = (m1 + 2.0) * c2 - 1.0  # Re((η² + 1) c² − 1)
+    bi = Q * c2
+    rp = qa * math.sqrt(br * br + bi * bi) / dp
+    F = 0.5 * (rs * rs + rp * rp)
+    return min(max(F, 0.0), 1.0)
+
+
+@jit
+def f_schlick(f0, c):
+    """Schlick (1994) ``F0 + (1 − F0)(1 − c)⁵``."""
+    m = 1.0 - min(max(c, 0.0), 1.0)
+    m2 = m * m
+    return f0 + (1.0 - f0) * (m2 * m2 * m)
+
+
+# ------------------------------------------------------ array API (wrappers)
+
+_v_dielectric = vectorize(f_dielectric, 2)
+_v_conductor = vectorize(f_conductor, 3)
+_v_schlick = vectorize(f_schlick, 2)
+
+
+def _dt(*args):
+    dt = np.result_type(*[np.asarray(a) for a in args], np.float32)
+    return np.dtype(np.float32) if dt == np.float32 else np.dtype(np.float64)
 
 
 def fresnel_dielectric_cook(c, n):
-    """Exact dielectric Fresnel reflectance in Cook-Torrance's form (relative index ``n``)."""
-    c = np.clip(np.asarray(c), 0.0, 1.0)
-    d = n * n - 1.0
-    g2 = d + c * c
-    tir = g2 < 0
-    # g = sqrt(n² − 1 + c²); for n ≥ 1 as hypot(sqrt(n² − 1), c) so that c² cannot underflow away
-    g = np.where(d >= 0, np.hypot(np.sqrt(np.maximum(d, 0.0)), c), np.sqrt(np.where(tir, 0.0, g2)))
-    # g + c == 0 only for n == 1 and c == 0 (no interface at all): F = 0 there,
-    # the value it has for every other c. den > 0 for c in [0, 1] since
-    # c (g − c) ≥ −c² ≥ −1 with equality only at n = 0.
-    gc = g + c
-    degenerate = gc == 0
-    a = (g - c) / np.where(degenerate, 1.0, gc)
-    num = c * gc - 1.0
-    den = c * (g - c) + 1.0
-    F = 0.5 * a * a * (1.0 + (num / den) ** 2)
-    return np.where(tir, 1.0, np.where(degenerate, 0.0, np.clip(F, 0.0, 1.0)))
+    """Exact dielectric Fresnel reflectance in Cook-Torrance's form (relative index ``n``). Source: :func:`f_dielectric`."""
+    return _v_dielectric(c, n, dtype=_dt(c, n))
 
 
 def fresnel_conductor(c, eta, k):
@@ -59,46 +144,14 @@ def fresnel_conductor(c, eta, k):
     ``B = Im g² = 2 eta k``: ``u, v = sqrt((|g²| ± A)/2)``, the smaller one as
     ``|B|/(2·larger)``. An index-1 "interface" gives exactly 0; ``k = 0`` is the
     dielectric case. float32 inputs (``c``, ``eta``, ``k``) give a float32 result.
+    Scalar source: :func:`f_conductor`.
     """
-    c = np.asarray(c)
-    dt = np.result_type(c, np.asarray(eta), np.asarray(k), np.float32)
-    zero, half, one, two = dt.type(0), dt.type(0.5), dt.type(1), dt.type(2)
-    c = np.clip(c.astype(dt, copy=False), zero, one)
-    eta = np.asarray(eta, dtype=dt)
-    k = np.asarray(k, dtype=dt)
-    m1 = (eta - one) * (eta + one) - k * k  # Re(η² − 1)
-    Q = two * eta * k  # Im η² (>= 0)
-    qa = np.hypot(m1, Q)  # |η² − 1|
-    c2 = c * c
-    A = m1 + c2  # Re g²
-    mod = np.hypot(A, Q)  # |g²|
-    with np.errstate(divide="ignore", invalid="ignore"):
-        big = np.sqrt(half * (mod + np.abs(A)))  # the larger of u, v
-        small = np.where(big > 0, half * np.abs(Q) / np.where(big > 0, big, one), zero)
-    u = np.where(A >= 0, big, small)
-    v = np.where(A >= 0, small, big)
-    ds = (c + u) ** 2 + v * v  # |c + g|²
-    dp = ((m1 + one) * c + u) ** 2 + (Q * c + v) ** 2  # |η² c + g|²
-    b_re = (m1 + two) * c2 - one  # (η² + 1) c² − 1
-    b_im = Q * c2
-    # Both denominators vanish only for η == 1 at c == 0 (no interface): F = 0 there,
-    # its value at every other c (|η² − 1| == 0 then anyway). Ratios are formed before
-    # squaring so that tiny |c + g|² cannot underflow to 0/0.
-    degenerate = (ds == 0) | (dp == 0)
-    ds = np.where(degenerate, one, ds)
-    dp = np.where(degenerate, one, dp)
-    rs = qa / ds
-    rp = qa * np.hypot(b_re, b_im) / dp
-    F = half * (rs * rs + rp * rp)
-    return np.where(degenerate, zero, np.clip(F, zero, one))
+    return _v_conductor(c, eta, k, dtype=_dt(c, eta, k))
 
 
 def fresnel_schlick(f0, c):
-    """Schlick (1994) approximation ``F0 + (1 − F0)(1 − c)⁵``."""
-    c = np.clip(np.asarray(c), 0.0, 1.0)
-    m = 1.0 - c
-    m2 = m * m
-    return f0 + (1.0 - f0) * (m2 * m2 * m)
+    """Schlick (1994) approximation ``F0 + (1 − F0)(1 − c)⁵``. Scalar source: :func:`f_schlick`."""
+    return _v_schlick(f0, c, dtype=_dt(f0, c))
 
 
 def f0_from_ior(n):
@@ -107,4 +160,12 @@ def f0_from_ior(n):
     return ((n - 1.0) / (n + 1.0)) ** 2
 
 
-__all__ = ["fresnel_dielectric_cook", "fresnel_conductor", "fresnel_schlick", "f0_from_ior"]
+__all__ = [
+    "f_dielectric",
+    "f_conductor",
+    "f_schlick",
+    "fresnel_dielectric_cook",
+    "fresnel_conductor",
+    "fresnel_schlick",
+    "f0_from_ior",
+]

@@ -22,18 +22,55 @@ function returns values in ``[0, 1]`` and never NaN.
 * :func:`smith_g_correlated` — the height-correlated form
   ``χ⁺ / (1 + Λ(wi) + Λ(wo))`` (Heitz 2014, eq. 99), always ``>=`` the
   separable one.
+
+Scalar sources (``g_vgroove``, ``g1_smith``) are compiled by
+:func:`brdfkit.engine.jit` for the kernels; the array functions wrap them.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from ..engine import jit, vectorize
 from .distributions import distribution as _distribution
 
+# ------------------------------------------------------------ scalar sources
 
-def _dt(x):
-    x = np.asarray(x)
-    return np.dtype(np.float32) if x.dtype == np.float32 else np.dtype(np.float64)
+
+@jit
+def g_vgroove(n_h, n_v, n_l, v_h, l_h):
+    """Torrance-Sparrow / Cook-Torrance (1982, eq. 6) V-groove ``min(1, 2(n·h)(n·v)/(v·h), 2(n·h)(n·l)/(l·h))``.
+
+    Negative cosines count as 0 (fully masked); a zero ``v·h`` or ``l·h`` leaves that term out.
+    """
+    n_h = max(n_h, 0.0)
+    n_v = max(n_v, 0.0)
+    n_l = max(n_l, 0.0)
+    v_h = max(v_h, 0.0)
+    l_h = max(l_h, 0.0)
+    g = 1.0
+    if v_h > 0.0:
+        g = min(g, 2.0 * n_h * n_v / v_h)
+    if l_h > 0.0:
+        g = min(g, 2.0 * n_h * n_l / l_h)
+    return max(g, 0.0)
+
+
+@jit
+def g1_smith(lam):
+    """Smith masking ``G1 = 1/(1 + Λ)`` (Smith 1967; Walter et al. 2007, eq. 23 form); Λ = +inf gives 0."""
+    return 1.0 / (1.0 + lam)
+
+
+# ------------------------------------------------------ array API (wrappers)
+
+_v_vgroove = vectorize(g_vgroove, 5)
+_v_g1 = vectorize(g1_smith, 1)
+
+
+def _dt(*args):
+    dt = np.result_type(*[np.asarray(a) for a in args], np.float32)
+    return np.dtype(np.float32) if dt == np.float32 else np.dtype(np.float64)
 
 
 def v_groove(n_h, n_v, n_l, v_h, l_h):
@@ -42,24 +79,15 @@ def v_groove(n_h, n_v, n_l, v_h, l_h):
     Arguments are the cosines (broadcasting arrays). Negative cosines are treated
     as 0 (the configuration is fully masked); a zero ``v·h`` or ``l·h`` leaves
     the corresponding term out (it is then +inf, so min picks the others).
+    Scalar source: :func:`g_vgroove`.
     """
-    n_h, n_v, n_l, v_h, l_h = np.broadcast_arrays(*(np.asarray(a) for a in (n_h, n_v, n_l, v_h, l_h)))
-    dt = np.result_type(n_h.dtype, n_v.dtype, n_l.dtype, v_h.dtype, l_h.dtype, np.float32)
-    zero, one, two = dt.type(0), dt.type(1), dt.type(2)
-    n_h, n_v, n_l, v_h, l_h = (np.maximum(a.astype(dt, copy=False), zero) for a in (n_h, n_v, n_l, v_h, l_h))
-    big = dt.type(np.inf)
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        g_mask = np.where(v_h > 0, two * n_h * n_v / np.where(v_h > 0, v_h, one), big)
-        g_shadow = np.where(l_h > 0, two * n_h * n_l / np.where(l_h > 0, l_h, one), big)
-    g = np.minimum(one, np.minimum(g_mask, g_shadow))
-    return np.maximum(g, zero)
+    return _v_vgroove(n_h, n_v, n_l, v_h, l_h, dtype=_dt(n_h, n_v, n_l, v_h, l_h))
 
 
 def g1_from_lambda(lam):
-    """Smith masking ``G1 = 1/(1 + Λ)`` (Λ = +inf gives 0)."""
+    """Smith masking ``G1 = 1/(1 + Λ)`` (Λ = +inf gives 0). Scalar source: :func:`g1_smith`."""
     lam = np.asarray(lam)
-    dt = _dt(lam)
-    return dt.type(1) / (dt.type(1) + lam.astype(dt, copy=False))
+    return _v_g1(lam, dtype=np.float32 if lam.dtype == np.float32 else np.float64)
 
 
 def _chi(w, h):
@@ -94,4 +122,4 @@ def smith_g_correlated(wi, wo, alpha_x, alpha_y=None, distribution="ggx", h=None
     return g
 
 
-__all__ = ["v_groove", "g1_from_lambda", "smith_g1", "smith_g_separable", "smith_g_correlated"]
+__all__ = ["g_vgroove", "g1_smith", "v_groove", "g1_from_lambda", "smith_g1", "smith_g_separable", "smith_g_correlated"]

@@ -21,6 +21,7 @@ uniform vec3 u_eta;
 uniform vec3 u_k;
 uniform vec3 u_wavelengths;
 uniform vec3 u_kd;
+uniform vec3 u_ks;  // scale of the directional-diffuse (and specular) part
 
 // W(z) for z = exp(lz) >= 0 (principal branch), Newton on w + ln w = lz
 float htsg_lambertw_from_log(float lz) {
@@ -204,5 +205,5 @@ vec3 brdf(vec3 wi, vec3 wo) {
     vec3 dd = vec3(htsg_channel(u_wavelengths.r, u_eta.r, u_k.r, sigma, vz, vxy2, cos_local, geo),
                    htsg_channel(u_wavelengths.g, u_eta.g, u_k.g, sigma, vz, vxy2, cos_local, geo),
                    htsg_channel(u_wavelengths.b, u_eta.b, u_k.b, sigma, vz, vxy2, cos_local, geo));
-    return max(dd + kd, vec3(0.0));
+    return max(u_ks * dd + kd, vec3(0.0));
 }

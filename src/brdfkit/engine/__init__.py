@@ -1,0 +1,132 @@
+"""The evaluation engine: one Python source per model, compiled (numba) or run as the reference.
+
+``bk.set_engine("compiled" | "reference")`` and the environment variable
+``BRDFKIT_ENGINE`` (read once, at import) pick how ``m.eval`` runs; ``bk.engine()``
+says which one is active (SPEC.md, "Evaluation engine"). Default: ``compiled``.
+
+* ``compiled`` — the model's scalar kernel, compiled by numba (nopython,
+  ``error_model="numpy"``, no fastmath), run by a parallel driver over flat views
+  of the direction arrays (chunked ``prange``), float32 or float64 in and out,
+  output allocated once. Kernels are cached on disk (see :mod:`.cache`), so a new
+  process pays no compile.
+* ``reference`` — THE SAME kernel functions, uncompiled: every numba dispatcher
+  the kernel calls is replaced by its original Python function
+  (:func:`brdfkit.engine.reference.pure`), evaluated pair by pair in Python
+  float64 (the result is then rounded to the input dtype). Slow (~10 µs per
+  pair), exact-source, and what the tests compare the compiled engine against.
+
+The two agree to 1e-12 relative in float64 (``tests/test_engine*.py``).
+
+How a model is converted (the kernel protocol)
+----------------------------------------------
+1. Write each physical term once as a small **scalar** function in component
+   form — floats in, floats (or a tuple of floats) out — decorated with
+   :func:`brdfkit.engine.jit`, in :mod:`brdfkit.terms` (shared terms) or in the
+   model module (terms only that model uses). Use only what numba nopython
+   compiles AND what plain Python runs without raising: ``math.*``,
+   arithmetic, ``min``/``max``, ``if``, simple loops; write ``x * x``, not
+   ``x ** 2`` (Python's ``**`` raises OverflowError where numba gives inf), and
+   guard every division and ``math.log``/``math.sqrt`` argument (Python raises
+   ZeroDivisionError / ValueError where numba gives inf/nan — the reference
+   engine would then fail, which is how the tests find an unguarded spot).
+   Cite the paper in the docstring, name the function after the term
+   (``d_ggx``, ``lambda_beckmann``, ``f_conductor``), keep it readable beside
+   its GLSL twin in ``render/shaders/``.
+2. Compose the model's kernel, also decorated with :func:`jit`, with EXACTLY
+   this signature::
+
+       @jit
+       def kernel(wix, wiy, wiz, wox, woy, woz, p, c):
+           ...
+           return r, g, b
+
+   ``wi``/``wo`` components are float64, and the kernel is called only for
+   ``wiz > 0`` and ``woz > 0`` (the driver writes the zero below the horizon).
+   ``p`` is a float64 1-D array of the numeric parameters, ``c`` an int64 1-D
+   array of the choice/bool parameters (choices as ints: the index in the
+   ``Param.choices`` tuple). Document the layout of ``p`` and ``c`` in the
+   kernel's docstring. Call the terms by their imported names (``d_ggx(...)``,
+   not ``distributions.d_ggx(...)``): the reference engine swaps names bound in
+   the kernel's module globals. Return finite, non-negative values; the driver
+   only clamps overflow to the dtype's largest finite value.
+3. On the model class set ``kernel = staticmethod(<your kernel>)`` and
+   implement ``kernel_args(self) -> (p, c)`` returning the two arrays (build them
+   once from ``self.params``; the base class caches nothing for you here, so
+   cache them in ``_setup``). Delete ``_eval`` or keep it — a model with a
+   ``kernel`` never has its ``_eval`` called. A model without ``kernel`` keeps
+   working through its numpy ``_eval`` (the fallback; both engines use it).
+4. Keep the array API of ``terms`` working as thin wrappers over the scalar
+   source: :func:`brdfkit.engine.vectorize` turns a scalar term into a ufunc-like
+   function (float32 stays float32, computed in float64), never a second copy
+   of the formula.
+5. Add the model to ``tests/test_engine_models.py`` (compiled vs reference for
+   every choice parameter) — or add its choice grid there.
+
+``BRDF.eval`` also enforces the unit-direction rule of SPEC.md for every model,
+whatever the engine: ``|wi|`` and ``|wo|`` within 1e-4 of 1 (float64) or 1e-3
+(float32), else ``ValueError`` naming the model, the argument and the worst
+length found.
+
+Numerics note: compiled kernels compute in float64 also for float32 input
+(numba types Python float literals as float64); float32 is the storage format
+of the fast path, and its values are the float64 result rounded once.
+"""
+
+from __future__ import annotations
+
+import os
+import sys as _sys
+import types as _types
+
+ENGINES = ("compiled", "reference")
+ENV_VAR = "BRDFKIT_ENGINE"
+
+
+def _from_env() -> str:
+    v = os.environ.get(ENV_VAR, "").strip().lower()
+    if v == "":
+        return "compiled"
+    if v not in ENGINES:
+        raise ValueError(f"{ENV_VAR}={v!r} is not a valid engine; valid: {', '.join(ENGINES)}")
+    return v
+
+
+_current = _from_env()
+
+# numba's parallel loops run on its "workqueue" threading layer, which survives fork()
+# (process pools: `check --all --jobs`, batch fitting); GNU OpenMP, numba's default
+# here, aborts a forked child. workqueue is not reentrant, so the driver serialises
+# calls from several Python threads with a lock (each call uses every core anyway).
+# An explicit NUMBA_THREADING_LAYER wins.
+if "NUMBA_THREADING_LAYER" not in os.environ:
+    import numba as _numba
+
+    _numba.config.THREADING_LAYER = "workqueue"
+
+
+def set_engine(name: str) -> None:
+    """Select the evaluation engine: ``"compiled"`` (default) or ``"reference"``."""
+    global _current
+    if not isinstance(name, str) or name.strip().lower() not in ENGINES:
+        raise ValueError(f"unknown engine {name!r}; valid: {', '.join(ENGINES)}")
+    _current = name.strip().lower()
+
+
+def engine() -> str:
+    """The active evaluation engine's name."""
+    return _current
+
+
+class _CallableModule(_types.ModuleType):
+    """``brdfkit.engine`` is this package and, called, the SPEC's ``bk.engine()``."""
+
+    def __call__(self) -> str:
+        return _current
+
+
+_sys.modules[__name__].__class__ = _CallableModule
+
+from .cache import jit, vectorize  # noqa: E402
+from .evaluate import evaluate, check_unit  # noqa: E402
+
+__all__ = ["ENGINES", "ENV_VAR", "set_engine", "engine", "jit", "vectorize", "evaluate", "check_unit"]

@@ -1,0 +1,126 @@
+"""numba compilation with an on-disk cache keyed by the package source.
+
+:func:`jit` is ``numba.njit(cache=True, error_model="numpy")`` with one
+difference: the cache lives in brdfkit's own folder, one sub-folder per content
+hash of every ``.py`` file of the package. numba's own cache is keyed by the
+source file of each function only, so a changed term in ``terms/`` would
+otherwise leave a stale compiled kernel of ``models/`` in use; with the hash in
+the path, any source change means a fresh compile, and an unchanged package
+loads every kernel from disk (a new process pays no compile).
+
+Folder: ``$BRDFKIT_CACHE_DIR`` if set, else ``$XDG_CACHE_HOME/brdfkit`` (default
+``~/.cache/brdfkit``), then ``numba-<hash>/``. If it cannot be created, numba
+falls back to its usual ``__pycache__`` locations.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import hashlib
+import os
+from pathlib import Path
+from typing import Callable, Iterator
+
+import numba
+import numpy as np
+
+_PKG = Path(__file__).resolve().parent.parent
+
+
+def source_hash() -> str:
+    """A short content hash of every ``.py`` file of the brdfkit package (sorted by path)."""
+    h = hashlib.sha1()
+    h.update(numba.__version__.encode())
+    for f in sorted(_PKG.rglob("*.py")):
+        try:
+            data = f.read_bytes()
+        except OSError:
+            continue
+        h.update(str(f.relative_to(_PKG)).encode())
+        h.update(data)
+    return h.hexdigest()[:16]
+
+
+def cache_root() -> Path:
+    base = os.environ.get("BRDFKIT_CACHE_DIR")
+    if base:
+        return Path(base)
+    xdg = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    return Path(xdg) / "brdfkit"
+
+
+_DIR: Path | None = None
+
+
+def cache_dir() -> Path:
+    """This source tree's numba cache folder (created on first use)."""
+    global _DIR
+    if _DIR is None:
+        d = cache_root() / f"numba-{source_hash()}"
+        try:
+            d.mkdir(parents=True, exist_ok=True)
+        except OSError:
+            pass
+        _DIR = d
+    return _DIR
+
+
+@contextlib.contextmanager
+def in_cache_dir() -> Iterator[None]:
+    """numba's ``CACHE_DIR`` set to :func:`cache_dir` while functions are decorated, then restored."""
+    old = numba.config.CACHE_DIR
+    numba.config.CACHE_DIR = str(cache_dir())
+    try:
+        yield
+    finally:
+        numba.config.CACHE_DIR = old
+
+
+JIT_OPTIONS = dict(cache=True, error_model="numpy", nogil=True)
+
+
+def jit(fn: Callable) -> Callable:
+    """Decorator for scalar terms and kernels: nopython, cached, ``error_model="numpy"``, no fastmath."""
+    with in_cache_dir():
+        return numba.njit(**JIT_OPTIONS)(fn)
+
+
+class vectorize:
+    """An array function over a scalar term: broadcasting, float64 computation, any output dtype.
+
+    ``vectorize(d_ggx)(hx, hy, hz, ax, ay)`` applies the scalar source element-wise
+    (a numba ufunc built lazily and cached on disk; under the reference engine the
+    uncompiled Python function via ``np.frompyfunc``). The result is float64;
+    pass ``dtype=np.float32`` to round it once to float32.
+    """
+
+    def __init__(self, scalar: Callable, nargs: int) -> None:
+        self.scalar = scalar
+        self.nargs = nargs
+        self._ufunc = None
+        self.__doc__ = getattr(scalar, "__doc__", None)
+        self.__name__ = getattr(scalar, "__name__", "vectorized")
+
+    def _compiled(self):
+        if self._ufunc is None:
+            py = getattr(self.scalar, "py_func", self.scalar)
+            sig = "float64(" + ",".join(["float64"] * self.nargs) + ")"
+            with in_cache_dir():
+                self._ufunc = numba.vectorize([sig], cache=True)(py)
+        return self._ufunc
+
+    def __call__(self, *args, dtype=np.float64) -> np.ndarray:
+        from . import engine
+        from .reference import pure
+
+        arrs = [np.asarray(a, dtype=np.float64) for a in args]
+        if engine() == "reference":
+            f = np.frompyfunc(pure(self.scalar), self.nargs, 1)
+            out = np.asarray(f(*arrs), dtype=np.float64)
+        else:
+            out = self._compiled()(*arrs)
+        with np.errstate(over="ignore"):
+            return np.asarray(out).astype(dtype, copy=False)
+
+
+__all__ = ["jit", "vectorize", "cache_dir", "source_hash", "in_cache_dir", "JIT_OPTIONS"]

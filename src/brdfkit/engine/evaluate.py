@@ -1,0 +1,122 @@
+"""``BRDF.eval`` through the engine: broadcasting, dtype, the unit check, then kernel or fallback."""
+
+from __future__ import annotations
+
+import math
+
+import numba
+import numpy as np
+
+from .cache import jit
+
+#: allowed deviation of a direction's length from 1, by working dtype (SPEC.md)
+UNIT_TOL = {np.dtype(np.float64): 1e-4, np.dtype(np.float32): 1e-3}
+
+
+@jit
+def _length_stats(w):
+    """(min length, max length, NaN count) of the rows of a C-contiguous ``(n, 3)`` array."""
+    lmin = math.inf
+    lmax = -math.inf
+    nan = 0
+    for j in range(w.shape[0]):
+        x = numba.float64(w[j, 0])
+        y = numba.float64(w[j, 1])
+        z = numba.float64(w[j, 2])
+        n = x * x + y * y + z * z
+        nan += n != n
+        lmin = min(lmin, n)
+        lmax = max(lmax, n)
+    return math.sqrt(lmin), math.sqrt(lmax), nan
+
+
+def _length_stats_np(w: np.ndarray) -> tuple[float, float, int]:
+    if w.shape[0] == 0:
+        return 1.0, 1.0, 0
+    if w.dtype in (np.float32, np.float64) and w.flags.c_contiguous:
+        lmin, lmax, nan = _length_stats(w)
+        return float(lmin), float(lmax), int(nan)
+    n = np.sqrt(np.einsum("...i,...i->...", w, w, dtype=np.float64))  # pragma: no cover
+    return float(np.nanmin(n)), float(np.nanmax(n)), int(np.isnan(n).sum())  # pragma: no cover
+
+
+def check_unit(name: str, arg: str, lmin: float, lmax: float, nan: int, dtype) -> None:
+    """Raise the SPEC's ValueError unless every length lies within the dtype's tolerance of 1."""
+    tol = UNIT_TOL[np.dtype(dtype)]
+    if nan:
+        worst = math.nan
+    elif max(1.0 - lmin, lmax - 1.0) <= tol:
+        return
+    else:
+        worst = lmin if (1.0 - lmin) >= (lmax - 1.0) else lmax
+    raise ValueError(
+        f"{name}: {arg} must be unit vectors (length within {tol:g} of 1 for {np.dtype(dtype).name}); "
+        f"found length {worst:.6g} (normalise with bk.geometry.normalize)"
+    )
+
+
+def _flat(a: np.ndarray, shape: tuple[int, ...]) -> np.ndarray:
+    """``a`` broadcast to ``shape`` as a C-contiguous ``(n, 3)`` array: a view when ``a`` already has the shape."""
+    if a.shape != shape:
+        a = np.broadcast_to(a, shape)
+    return np.ascontiguousarray(a).reshape(-1, 3)
+
+
+def evaluate(model, wi, wo) -> np.ndarray:
+    """The whole ``BRDF.eval`` contract for ``model`` (see :mod:`brdfkit.models.base`)."""
+    from . import engine
+    from . import driver, reference
+
+    wi = np.asarray(wi)
+    wo = np.asarray(wo)
+    name = model.name
+    if wi.shape[-1:] != (3,) or wo.shape[-1:] != (3,):
+        raise ValueError(f"{name}: directions must have a last axis of length 3, got {wi.shape} and {wo.shape}")
+    dtype = np.dtype(np.float32) if (wi.dtype == np.float32 and wo.dtype == np.float32) else np.dtype(np.float64)
+    wi = wi.astype(dtype, copy=False)
+    wo = wo.astype(dtype, copy=False)
+    try:
+        shape = np.broadcast_shapes(wi.shape, wo.shape)
+    except ValueError:
+        raise ValueError(f"{name}: wi of shape {wi.shape} and wo of shape {wo.shape} do not broadcast") from None
+    kernel = getattr(type(model), "kernel", None)
+    args = model.kernel_args() if kernel is not None else None
+    fi = _flat(wi, shape)
+    fo = _flat(wo, shape)
+    if args is not None:
+        p, c = args
+        out = np.empty(shape, dtype=dtype)
+        fout = out.reshape(-1, 3)
+        if engine() == "compiled":
+            nrm = driver.run(kernel, fi, fo, p, c, fout)
+            check_unit(name, "wi", math.sqrt(nrm[:, 0].min()), math.sqrt(nrm[:, 1].max()), int(nrm[:, 2].sum()), dtype)
+            check_unit(name, "wo", math.sqrt(nrm[:, 3].min()), math.sqrt(nrm[:, 4].max()), int(nrm[:, 5].sum()), dtype)
+        else:
+            check_unit(name, "wi", *_length_stats_np(fi), dtype)
+            check_unit(name, "wo", *_length_stats_np(fo), dtype)
+            reference.run(kernel, fi, fo, p, c, fout)
+        return out
+    check_unit(name, "wi", *_length_stats_np(fi), dtype)
+    check_unit(name, "wo", *_length_stats_np(fo), dtype)
+    return _fallback(model, fi.reshape(shape), fo.reshape(shape), dtype)
+
+
+def _fallback(model, wi: np.ndarray, wo: np.ndarray, dtype) -> np.ndarray:
+    """A model without a kernel: its numpy ``_eval`` on directions above the horizon (both engines)."""
+    valid = (wi[..., 2] > 0) & (wo[..., 2] > 0)
+    all_valid = bool(valid.all())
+    if not all_valid:
+        up = np.zeros(3, dtype=dtype)
+        up[2] = 1
+        wi = np.where(valid[..., None], wi, up)
+        wo = np.where(valid[..., None], wo, up)
+    p = model._typed_params(dtype.type)
+    with np.errstate(all="ignore"):
+        f = model._eval(wi, wo, p)
+    f = np.broadcast_to(np.asarray(f, dtype=dtype), wi.shape)
+    if not all_valid:
+        f = np.where(valid[..., None], f, dtype.type(0))
+    return np.ascontiguousarray(f)
+
+
+__all__ = ["evaluate", "check_unit", "UNIT_TOL"]

@@ -1,0 +1,243 @@
+"""The evaluation engine: selection, the unit-direction rule, the driver, the fallback, the reference twin."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import brdfkit as bk
+from brdfkit import engine
+from brdfkit.engine import driver, reference
+from brdfkit.geometry import random_unit_vectors
+from brdfkit.models.base import BRDF
+from brdfkit.params import kd_param
+
+
+@pytest.fixture
+def restore_engine():
+    old = engine.engine()
+    yield
+    engine.set_engine(old)
+
+
+def test_set_engine_and_query(restore_engine):
+    assert bk.engine() in engine.ENGINES
+    bk.set_engine("reference")
+    assert bk.engine() == "reference"
+    bk.set_engine("compiled")
+    assert bk.engine() == "compiled"
+    with pytest.raises(ValueError, match="unknown engine 'fast'.*compiled, reference"):
+        bk.set_engine("fast")
+    assert bk.engine() == "compiled"
+
+
+@pytest.mark.parametrize("value,expect", [("reference", "reference"), ("compiled", "compiled"), ("", "compiled")])
+def test_env_var_picks_the_engine(value, expect):
+    env = dict(os.environ, BRDFKIT_ENGINE=value)
+    out = subprocess.run([sys.executable, "-c", "import brdfkit as bk; print(bk.engine())"],
+                         env=env, capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == expect
+
+
+def test_env_var_rejects_unknown_engine():
+    env = dict(os.environ, BRDFKIT_ENGINE="turbo")
+    out = subprocess.run([sys.executable, "-c", "import brdfkit"], env=env, capture_output=True, text=True)
+    assert out.returncode != 0 and "BRDFKIT_ENGINE='turbo' is not a valid engine" in out.stderr
+
+
+def _pairs(n, seed=0, dtype=np.float64):
+    rng = np.random.default_rng(seed)
+    return random_unit_vectors(n, rng).astype(dtype), random_unit_vectors(n, rng).astype(dtype)
+
+
+@pytest.mark.parametrize("eng", engine.ENGINES)
+@pytest.mark.parametrize("name", ["microfacet", "lambert", "ward"])  # ward: a model still on the fallback (or not)
+@pytest.mark.parametrize("dtype,tol", [(np.float64, 1e-4), (np.float32, 1e-3)])
+def test_non_unit_directions_are_rejected(eng, name, dtype, tol, restore_engine):
+    bk.set_engine(eng)
+    m = bk.model(name)
+    wi, wo = _pairs(50, dtype=dtype)
+    for scale, arg in ((0.5, "wi"), (2.0, "wo")):
+        a, b = (wi * dtype(scale), wo) if arg == "wi" else (wi, wo * dtype(scale))
+        with pytest.raises(ValueError) as e:
+            m.eval(a, b)
+        msg = str(e.value)
+        assert msg.startswith(f"{name}: {arg} must be unit vectors") and f"found length {scale:g}" in msg
+        assert "\n" not in msg
+    # just inside the tolerance is accepted, just outside is not
+    ok = wi * dtype(1 + 0.5 * tol)
+    assert np.all(np.isfinite(m.eval(ok, wo)))
+    bad = wi.copy()
+    bad[7] *= dtype(1 + 3 * tol)
+    with pytest.raises(ValueError, match="wi must be unit"):
+        m.eval(bad, wo)
+    nan = wo.copy()
+    nan[3, 0] = np.nan
+    with pytest.raises(ValueError, match="wo must be unit vectors.*found length nan"):
+        m.eval(wi, nan)
+    # a zero vector is not a direction either, below the horizon or not
+    zero = wi.copy()
+    zero[0] = 0
+    with pytest.raises(ValueError, match="found length 0"):
+        m.eval(zero, wo)
+
+
+def test_worst_length_is_reported_across_chunks():
+    m = bk.model("microfacet")
+    n = 5 * driver.CHUNK + 17
+    wi, wo = _pairs(n)
+    wi[3 * driver.CHUNK + 5] *= 1.3
+    wi[10] *= 0.9
+    with pytest.raises(ValueError, match="found length 1.3"):
+        m.eval(wi, wo)
+
+
+@pytest.mark.parametrize("n", [0, 1, 7, driver.CHUNK, driver.CHUNK + 1, 3 * driver.CHUNK + 5])
+def test_driver_sizes_and_horizon(n):
+    m = bk.model("microfacet", kd=0.3)
+    rng = np.random.default_rng(n)
+    wi = random_unit_vectors(n, rng, hemisphere=False)
+    wo = random_unit_vectors(n, rng, hemisphere=False)
+    f = m.eval(wi, wo)
+    assert f.shape == (n, 3) and f.dtype == np.float64
+    below = (wi[:, 2] <= 0) | (wo[:, 2] <= 0)
+    assert np.all(f[below] == 0)
+    assert np.all(f[~below] >= 0.3 / np.pi * (1 - 1e-15))
+    for j in range(0, n, max(1, n // 5)):  # chunk boundaries: equal to one-pair calls
+        assert np.array_equal(f[j], m.eval(wi[j], wo[j]))
+
+
+def test_shapes_broadcast_and_views():
+    m = bk.model("microfacet", alpha_x=0.1, alpha_y=0.4)
+    wi, wo = _pairs(12, seed=2)
+    table = m.eval(wi[:, None, :], wo[None, :6, :])
+    assert table.shape == (12, 6, 3)
+    assert np.array_equal(table[4, 5], m.eval(wi[4], wo[5]))
+    # a non-contiguous view in, the same numbers out
+    big = np.zeros((12, 6))
+    big[:, ::2] = wi
+    assert np.array_equal(m.eval(big[:, ::2], wo), m.eval(wi, wo))
+    assert m.eval(wi[0], wo[0]).shape == (3,)
+    with pytest.raises(ValueError, match="do not broadcast"):
+        m.eval(wi[:5], wo[:4])
+
+
+def test_float32_in_float32_out_and_clamped():
+    wi, wo = _pairs(1000, seed=5, dtype=np.float32)
+    m = bk.model("microfacet", alpha=1e-3)
+    f = m.eval(wi, wo)
+    assert f.dtype == np.float32 and np.all(np.isfinite(f))
+    # the float32 value is the float64 kernel's value, rounded once
+    f64 = m.eval(wi.astype(np.float64), wo.astype(np.float64))
+    assert np.array_equal(f, f64.astype(np.float32))
+
+
+def test_reference_runs_the_same_source_uncompiled():
+    from brdfkit.models.microfacet import microfacet_kernel
+    from brdfkit.terms import distributions as D
+
+    k = reference.pure(microfacet_kernel)
+    assert k.__code__ is microfacet_kernel.py_func.__code__
+    # every jitted name the kernel calls is replaced by its Python twin, recursively
+    assert not hasattr(k.__globals__["d_of"], "py_func")
+    assert k.__globals__["d_of"].__code__ is D.d_of.py_func.__code__
+    assert not hasattr(k.__globals__["d_of"].__globals__["d_ggx"], "py_func")
+    # and it runs on plain Python floats
+    r, g, b = k(0.0, 0.0, 1.0, 0.0, 0.0, 1.0, [0.2, 0.2] + [1.5] * 3 + [0.0] * 3 + [0.04] * 3 + [0.0] * 3 + [1.0] * 3, [1, 0, 2])
+    assert isinstance(r, float) and r == pytest.approx(0.04 / (4 * np.pi * 0.04), rel=1e-12)
+
+
+class _NumpyOnly(BRDF):
+    """A model in today's numpy ``_eval`` style (as third-party models are written): served by the fallback."""
+
+    name = "_numpy_only"
+    spec = (kd_param(0.5),)
+
+    def _eval(self, wi, wo, p):
+        return p["kd"] / np.pi * (1 + 0 * wi[..., :1])
+
+
+@pytest.mark.parametrize("eng", engine.ENGINES)
+def test_models_without_a_kernel_use_their_numpy_eval(eng, restore_engine):
+    bk.set_engine(eng)
+    m = _NumpyOnly(kd=(0.1, 0.2, 0.3))
+    wi, wo = _pairs(20, seed=1)
+    wo[:5, 2] *= -1
+    f = m.eval(wi, wo)
+    assert np.all(f[:5] == 0)
+    assert np.allclose(f[5:], np.array([0.1, 0.2, 0.3]) / np.pi, rtol=1e-15)
+    assert m.eval(wi.astype(np.float32), wo.astype(np.float32)).dtype == np.float32
+    with pytest.raises(ValueError, match="_numpy_only: wo must be unit"):
+        m.eval(wi, wo * 3)
+
+
+def test_kernels_are_cached_on_disk(tmp_path):
+    """A fresh process with a warm cache compiles nothing (numba reports cache hits, no misses)."""
+    code = (
+        "import numpy as np, brdfkit as bk\n"
+        "from brdfkit.engine import driver\n"
+        "from brdfkit.models.microfacet import microfacet_kernel\n"
+        "m = bk.model('microfacet')\n"
+        "w = np.array([[0.0, 0.6, 0.8]] * 5000)\n"
+        "m.eval(w, w); m.eval(w.astype(np.float32), w.astype(np.float32))\n"
+        "s = driver.driver_for(microfacet_kernel).stats\n"
+        "print(sum(s.cache_hits.values()), sum(s.cache_misses.values()))\n"
+    )
+    env = dict(os.environ, BRDFKIT_CACHE_DIR=str(tmp_path))
+    first = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True)
+    assert first.stdout.split() == ["0", "2"]  # compiled: float64 and float32
+    second = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True)
+    assert second.stdout.split() == ["2", "0"]
+    assert any(tmp_path.glob("numba-*/drivers/drv_brdfkit_models_microfacet_microfacet_kernel.py"))
+
+
+def test_scalar_half_vector_matches_the_array_one_at_grazing():
+    """geometry.half_vector (numpy, for array callers) and half_vector_c (kernels) give the same h."""
+    from brdfkit import geometry as g
+
+    wi, wo = _pairs(200, seed=9)
+    extra_i = np.array([[1.0, 0.0, 1e-300], [0.6, 0.8, 0.0], [0.0, 0.0, 1.0], [0.3, 0.4, np.sqrt(0.75)]])
+    extra_o = np.array([[-1.0, 0.0, 1e-300], [-0.6, -0.8, 0.0], [0.0, 0.0, 1.0], [-0.3, -0.4, np.sqrt(0.75)]])
+    wi = np.concatenate([wi, extra_i])
+    wo = np.concatenate([wo, extra_o])
+    h = g.half_vector(wi, wo)
+    pure = reference.pure(g.half_vector_c)
+    for j in range(len(wi)):
+        hc = g.half_vector_c(*wi[j], *wo[j])
+        assert np.allclose(hc, h[j], rtol=1e-15, atol=1e-16), (wi[j], wo[j], hc, h[j])
+        assert pure(*map(float, wi[j]), *map(float, wo[j])) == hc
+
+
+def test_term_array_wrappers_run_the_scalar_source_on_both_engines(restore_engine):
+    """terms.* array functions: compiled ufuncs and, under the reference engine, the same Python functions."""
+    from brdfkit.terms import distributions as D
+    from brdfkit.terms import fresnel as F
+    from brdfkit.terms import shadowing as S
+
+    h = random_unit_vectors(300, np.random.default_rng(1))
+    calls = [
+        lambda: D.ggx(h, 0.2, 0.3),
+        lambda: D.beckmann(h, 0.05, 0.5),
+        lambda: D.beckmann_lambda(h, 0.2, 0.5),
+        lambda: D.ggx_lambda(h, 0.7),
+        lambda: F.fresnel_conductor(h[:, 2], np.float64(1.0001), 0.0),
+        lambda: F.fresnel_dielectric_cook(h[:, 2], 1.5),
+        lambda: S.v_groove(h[:, 2], h[:, 2], np.abs(h[:, 1]), np.abs(h[:, 0]), h[:, 2]),
+    ]
+    bk.set_engine("compiled")
+    a = [f() for f in calls]
+    bk.set_engine("reference")
+    b = [f() for f in calls]
+    for x, y in zip(a, b):
+        assert x.dtype == y.dtype == np.float64
+        np.testing.assert_allclose(x, y, rtol=1e-13, atol=0)
+    # float32 in, float32 out (the float64 value rounded once)
+    h32 = h.astype(np.float32)
+    bk.set_engine("compiled")
+    g32 = D.ggx(h32, np.float32(0.2))
+    assert g32.dtype == np.float32
+    assert np.array_equal(g32, D.ggx(h32.astype(np.float64), float(np.float32(0.2))).astype(np.float32))
