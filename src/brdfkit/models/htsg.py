@@ -262,11 +262,12 @@ def asymptotic_coefficients(order: int = ASYMPTOTIC_ORDER) -> list[list[Fraction
     return out
 
 
-_QS = [[float(c) for c in q] for q in asymptotic_coefficients(ASYMPTOTIC_ORDER)]
-#: Q_1..Q_N flattened (a tuple, a compile-time constant for numba): Q_n's coefficients (power of
+#: Q_0..Q_N as float arrays (index = power of a); the GLSL twin's htsg_q<n> hold the same numbers
+_Q = [np.array([float(c) for c in q]) for q in asymptotic_coefficients(ASYMPTOTIC_ORDER)]
+#: the same, flattened (a tuple, a compile-time constant for numba): Q_n's coefficients (power of
 #: a ascending) start at _Q_OFF[n] and number n + 2
-_Q_FLAT = tuple(c for q in _QS for c in q)
-_Q_OFF = tuple(int(x) for x in np.cumsum([0] + [len(q) for q in _QS])[:-1])
+_Q_FLAT = tuple(float(c) for q in _Q for c in q)
+_Q_OFF = tuple(int(x) for x in np.cumsum([0] + [len(q) for q in _Q])[:-1])
 
 
 @jit
