@@ -184,13 +184,17 @@ def test_resume_after_a_crash_completes_the_identical_table(reference, tmp_path)
 def test_interrupt_keeps_finished_fits_and_says_so(tmp_path):
     out = tmp_path / "int"
     args = _cli("-m", "lambert", "-m", "blinn-phong", "-m", "ward", *CLI_ARGS, "--out", str(out), "--workers", "1")
-    p = subprocess.Popen(args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, env=_env(), start_new_session=True)
+    # a process started with SIGINT ignored (as pytest-xdist workers and background shells do) would
+    # inherit that and never see Ctrl-C: give the command the default disposition, as a terminal does
+    p = subprocess.Popen(args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, env=_env(), start_new_session=True,
+                         preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     try:
         t0 = time.time()
         while time.time() - t0 < 60 and p.poll() is None:
             if (out / "fits").is_dir() and len(list((out / "fits").glob("*.json"))) >= 2:
                 break
             time.sleep(0.02)
+        assert p.poll() is None, "the batch ended before it could be interrupted"
         os.kill(p.pid, signal.SIGINT)
         _, stderr = p.communicate(timeout=60)
     finally:
