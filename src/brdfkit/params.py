@@ -336,8 +336,8 @@ def ks_param(default: Any = 0.5, doc: str = "specular weight", hi: float = 1.0) 
 
 
 def exponent_param(name: str, default: float, doc: str) -> Param:
-    """A cosine-power exponent (Phong shininess, Ashikhmin-Shirley n_u/n_v): [0, 1e5], fitted in [1, 1e4]."""
-    return Param(name, "scalar", default, (0.0, 1e5), "", doc, fit_range=(1.0, 1e4), log_scale=True)
+    """A cosine-power exponent (Phong shininess, Ashikhmin-Shirley n_u/n_v): [0, 1e5], fitted in all of [1, 1e5]."""
+    return Param(name, "scalar", default, (0.0, 1e5), "", doc, fit_range=(1.0, 1e5), log_scale=True)
 
 
 __all__ = [

@@ -56,50 +56,46 @@ def _fmt_params(params: dict[str, Any]) -> str:
 
 # --------------------------------------------------------------------------- batch output
 def write_batch(results, models: list[str], sources: list[str], out_dir: str, metric: str, seconds: float) -> dict[str, str]:
-    """CSV, Markdown, sorted-error PNG and parameters JSON of a batch; returns the paths."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    """CSV, Markdown, sorted-error PNGs and parameters JSON of a batch of FitResults; returns the paths."""
+    from .batch import Job, write_tables
 
     os.makedirs(out_dir, exist_ok=True)
-    table = {(r.source, r.model.name): r for r in results}
-    csv_path = os.path.join(out_dir, "fit_errors.csv")
-    with open(csv_path, "w") as fh:
-        fh.write("material," + ",".join(models) + "\n")
-        for s in sources:
-            fh.write(s + "," + ",".join(f"{table[(s, m)].error:.6g}" for m in models) + "\n")
-    md_path = os.path.join(out_dir, "fit_errors.md")
-    errs = np.array([[table[(s, m)].error for m in models] for s in sources])
-    best = errs.argmin(axis=1)
-    with open(md_path, "w") as fh:
-        fh.write(f"Fitting error per material and model; metric: {metric}. Best per row in bold.\n\n")
-        fh.write("| material | " + " | ".join(models) + " |\n")
-        fh.write("|---|" + "---:|" * len(models) + "\n")
-        for i, s in enumerate(sources):
-            cells = [f"**{e:.4g}**" if j == best[i] else f"{e:.4g}" for j, e in enumerate(errs[i])]
-            fh.write(f"| {s} | " + " | ".join(cells) + " |\n")
-        fh.write("| **median** | " + " | ".join(f"{np.median(errs[:, j]):.4g}" for j in range(len(models))) + " |\n")
-        fh.write("| **mean** | " + " | ".join(f"{np.mean(errs[:, j]):.4g}" for j in range(len(models))) + " |\n")
-        fh.write("| **best on** | " + " | ".join(str(int((best == j).sum())) for j in range(len(models))) + " |\n")
-        fh.write(f"\n{len(sources)} materials × {len(models)} models fitted in {seconds:.0f} s.\n")
-    png_path = os.path.join(out_dir, "fit_errors_sorted.png")
-    fig, ax = plt.subplots(figsize=(8, 4.8), dpi=110)
-    for j, m in enumerate(models):
-        ax.plot(np.arange(1, len(sources) + 1), np.sort(errs[:, j]), label=m, lw=1.6)
-    ax.set_yscale("log")
-    ax.set_xlabel("materials, sorted by error (per model)")
-    ax.set_ylabel(f"fitting error ({metric})")
-    ax.set_title(f"Fit of {len(models)} analytic models to {len(sources)} measured materials")
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend()
-    fig.tight_layout()
-    fig.savefig(png_path)
-    plt.close(fig)
-    json_path = os.path.join(out_dir, "fit_params.json")
-    with open(json_path, "w") as fh:
-        json.dump([r.to_json() for r in results], fh, indent=1)
-    return {"csv": csv_path, "markdown": md_path, "plot": png_path, "params": json_path}
+    recs, jobs = [], []
+    for r in results:
+        rec = r.to_json()
+        rec["column"] = r.model.name
+        recs.append(rec)
+        jobs.append(Job(r.source, r.model.name, r.model.name))
+    return write_tables(recs, jobs, list(models), list(sources), out_dir, metric, seconds)
+
+
+def parse_samples(text: str) -> int | str:
+    """``--samples``: a number (at least 16) or ``table`` (every measured bin)."""
+    t = str(text).strip().lower()
+    if t == "table":
+        return "table"
+    try:
+        n = int(t)
+    except ValueError:
+        raise ValueError(f"--samples must be a number of samples or 'table', got {text!r}") from None
+    if n < 16:
+        raise ValueError(f"--samples must be at least 16 (or 'table'), got {n}")
+    return n
+
+
+def parse_model_spec(text: str) -> tuple[str, str, list[str]]:
+    """``--model NAME[:k=v[:k=v...]]`` -> (column label, registry name, ``k=v`` items).
+
+    The same model can so appear twice with different options, e.g. ``ward`` and
+    ``ward:normalization=dur`` (Ngan et al.'s Ward and Ward-Dür); the label is the text given."""
+    from .. import registry
+
+    name, *items = [x.strip() for x in text.split(":")]
+    registry.get(name)
+    for it in items:
+        if "=" not in it:
+            raise ValueError(f"--model {text!r}: expected NAME:name=value, got {it!r}")
+    return text, name, items
 
 
 def register(app: typer.Typer) -> None:
@@ -108,11 +104,14 @@ def register(app: typer.Typer) -> None:
         source: Optional[str] = typer.Argument(
             None, help="a MERL .binary file or a built-in material (e.g. merl/gold-metallic-paint)"
         ),
-        model: List[str] = typer.Option([], "--model", "-m", help="analytic model to fit (repeat with --all-measured)"),
+        model: List[str] = typer.Option([], "--model", "-m",
+                                        help="analytic model to fit; with --all-measured repeatable, "
+                                             "and NAME:k=v[:k=v] fixes options of that column"),
         param: List[str] = typer.Option([], "--param", "-p", help="hold a parameter fixed: name=value (repeatable)"),
         metric: str = typer.Option("ngan", "--metric", help="ngan (cosine-weighted RMS), l2, log or cbrt"),
         starts: int = typer.Option(4, "--starts", help="local optimisations (multi-start)"),
-        samples: int = typer.Option(3000, "--samples", help="measured samples used for fitting"),
+        samples: str = typer.Option("3000", "--samples", help="measured samples used for fitting, or 'table' (every bin)"),
+        lobes: int = typer.Option(1, "--lobes", help="1, or 2 for a second specular lobe (Ngan et al. 2005)"),
         seed: int = typer.Option(0, "--seed", help="random seed of the sampling and the starts"),
         as_json: bool = typer.Option(False, "--json", help="print the result as JSON"),
         report: Optional[str] = typer.Option(None, "--report", help="write a report (slices, spheres) into DIR"),
@@ -120,6 +119,10 @@ def register(app: typer.Typer) -> None:
         set_name: str = typer.Option("all", "--set", help="with --all-measured: merl, rgl, nielsen or all"),
         limit: int = typer.Option(0, "--limit", help="with --all-measured: only the first N materials"),
         out: str = typer.Option("fit-results", "--out", "-o", help="with --all-measured: output folder"),
+        scheduler: Optional[str] = typer.Option(None, "--scheduler",
+                                                help="with --all-measured: a Dask scheduler, tcp://HOST:PORT"),
+        workers: int = typer.Option(0, "--workers", help="with --all-measured, no --scheduler: local processes (0: one per CPU)"),
+        resume: bool = typer.Option(False, "--resume", help="with --all-measured: keep the fits already in --out"),
     ) -> None:
         """Fit an analytic model to a measured material (MERL file or built-in); or a whole batch."""
         from .. import registry
@@ -129,27 +132,37 @@ def register(app: typer.Typer) -> None:
             raise ValueError(f"unknown metric {metric!r}; valid metrics: {', '.join(METRICS)}")
         if not model:
             raise ValueError("missing --model NAME; valid models: " + ", ".join(registry.names()))
-        for m in model:
-            registry.get(m)
+        n_samples = parse_samples(samples)
+        if lobes not in (1, 2):
+            raise ValueError(f"--lobes must be 1 or 2, got {lobes}")
         if all_measured:
             if source is not None:
                 raise ValueError("give either SOURCE or --all-measured, not both")
-            _batch(model, param, metric, starts, samples, seed, set_name, limit, out, as_json)
+            _batch(model, param, metric, starts, n_samples, seed, set_name, limit, out, as_json, lobes,
+                   scheduler, workers, resume)
             return
+        for flag, given in (("--scheduler", scheduler is not None), ("--resume", resume), ("--workers", workers != 0)):
+            if given:
+                raise ValueError(f"{flag} needs --all-measured")
         if source is None:
             raise ValueError("missing SOURCE: a MERL .binary file or a built-in material (see brdfkit list --measured)")
         if len(model) != 1:
             raise ValueError("fit one --model at a time for a single SOURCE (several models need --all-measured)")
-        _single(source, model[0], param, metric, starts, samples, seed, as_json, report)
+        _, name, items = parse_model_spec(model[0])
+        _single(source, name, list(items) + list(param), metric, starts, n_samples, seed, as_json, report, lobes)
 
 
-def _single(source, model_name, param, metric, starts, samples, seed, as_json, report) -> None:
+def _single(source, model_name, param, metric, starts, samples, seed, as_json, report, lobes=1) -> None:
     from .fit import fit, resolve_source
 
     fixed = _fixed_for(model_name, param, strict=True)
+    if report:
+        from ..fileio import check_output_path
+
+        check_output_path(report, what="report", is_dir=True)
     measured = resolve_source(source)
     res = fit(model_name, measured, fixed=fixed, metric=metric, starts=starts, samples=samples, seed=seed,
-              progress=not as_json)
+              lobes=lobes, progress=not as_json)
     out = res.to_json()
     if report:
         from .report import write_report
@@ -161,33 +174,65 @@ def _single(source, model_name, param, metric, starts, samples, seed, as_json, r
     typer.echo(f"{model_name} fitted to {res.source}: error {res.error:.6g} ({metric}), "
                f"{res.samples} samples, {res.starts} starts, {res.seconds:.1f} s")
     typer.echo("  " + _fmt_params(res.params))
+    if res.at_bound:
+        typer.echo("  at a fitting bound: " + ", ".join(res.at_bound))
     if report:
         typer.echo(f"  report: {out['report']['index']}")
 
 
-def _batch(models, param, metric, starts, samples, seed, set_name, limit, out, as_json) -> None:
-    from .fit import fit_batch
+def _batch(models, param, metric, starts, samples, seed, set_name, limit, out, as_json, lobes=1,
+           scheduler=None, workers=0, resume=False) -> None:
+    import sys
+
+    from ..fileio import check_output_path
+    from .batch import run_batch
 
     sources = measured_names(set_name)
     if limit < 0:
         raise ValueError(f"--limit must be >= 0, got {limit}")
+    if workers < 0:
+        raise ValueError(f"--workers must be >= 0, got {workers}")
     if limit:
         sources = sources[:limit]
-    fixed = {m: _fixed_for(m, param, strict=False) for m in models}
-    used = {k for f in fixed.values() for k in f}
+    specs = [parse_model_spec(m) for m in models]
+    labels = [lab for lab, _, _ in specs]
+    if len(set(labels)) != len(labels):
+        raise ValueError("a --model is given twice")
+    fixed, used = {}, set()
+    names = {}
+    for lab, name, items in specs:
+        fixed[lab] = dict(_fixed_for(name, param, strict=False), **_fixed_for(name, items, strict=True))
+        used |= set(_fixed_for(name, param, strict=False))
+        names[lab] = name
     for item in param:
         if item.partition("=")[0].strip() not in used:
             raise ValueError(f"parameter assignment {item!r} matches none of the models {', '.join(models)}")
+    check_output_path(out, what="batch output", is_dir=True)
+    show = not as_json
     t0 = time.perf_counter()
-    results = fit_batch(models, sources, metric=metric, fixed=fixed, progress=not as_json,
-                        starts=starts, samples=samples, seed=seed)
-    seconds = time.perf_counter() - t0
-    paths = write_batch(results, list(models), sources, out, metric, seconds)
+
+    def progress(done, total, rec):
+        if show:
+            print(f"[{done}/{total}] {rec['source']} {rec['column']}: {rec['error']:.4g} "
+                  f"({time.perf_counter() - t0:.0f} s)", file=sys.stderr, flush=True)
+
+    try:
+        res = run_batch(labels, sources, out, names=names, fixed=fixed, metric=metric, samples=samples,
+                        starts=starts, seed=seed, lobes=lobes, scheduler=scheduler, workers=workers or None,
+                        resume=resume, progress=progress)
+    except KeyboardInterrupt:
+        print(f"brdfkit: interrupted; finished fits are kept in {os.path.join(out, 'fits')} "
+              "(run again with --resume)", file=sys.stderr, flush=True)
+        raise
+    paths = res.files
     if as_json:
-        print_json({"metric": metric, "seconds": round(seconds, 2), "files": paths,
-                    "results": [r.to_json() for r in results]})
+        print_json({"metric": metric, "seconds": round(res.seconds, 2), "files": paths, "fitted": res.fitted,
+                    "skipped": res.skipped, "at_bound": res.at_bound, "results": [r for r in res.records if r]})
         return
-    typer.echo(f"fitted {len(models)} model(s) to {len(sources)} material(s) in {seconds:.1f} s")
+    typer.echo(f"fitted {res.fitted} and kept {res.skipped} of {len(res.jobs)} fits "
+               f"({len(labels)} model(s) × {len(sources)} material(s)) in {res.seconds:.1f} s")
+    if res.at_bound:
+        typer.echo(f"  {len(res.at_bound)} fit(s) ended on a fitting bound (listed in fit_errors.md)")
     for k, v in paths.items():
         typer.echo(f"  {k}: {v}")
 

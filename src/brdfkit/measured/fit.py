@@ -166,6 +166,52 @@ def sample(measured: Any, n: int = 3000, seed: int = 0, max_theta_deg: float = 8
     return Samples(np.concatenate(wi_l), np.concatenate(wo_l), f, w / w.mean(), _source_label(model))
 
 
+def table(measured: Any, max_theta_deg: float = 80.0) -> Samples:
+    """Every measured bin as a sample (``samples="table"``): MERL's 90 × 90 × 180 bin centres with
+    both directions within ``max_theta_deg`` of the normal, φh = 0 (the data are isotropic),
+    weighted as :func:`sample` weights them. From a MERL table the values are the table's (bins
+    marked missing are left out); from any other isotropic model (a built-in material) the model
+    is evaluated at the bin centres."""
+    model = resolve_source(measured)
+    if not getattr(model, "isotropic", True):
+        raise ValueError(f"{_source_label(model)}: fitting needs isotropic measured data")
+    if not (0 < max_theta_deg <= 90):
+        raise ValueError(f"max_theta_deg must be in (0, 90], got {max_theta_deg}")
+    cos_max = math.cos(math.radians(max_theta_deg)) if max_theta_deg < 90 else 0.0
+    th, td, pd = bin_centres()
+    I, J, K = np.meshgrid(np.arange(RES_THETA_H), np.arange(RES_THETA_D), np.arange(RES_PHI_D), indexing="ij")
+    I, J, K = I.ravel(), J.ravel(), K.ravel()
+    wi, wo = from_rusinkiewicz(th[I], np.zeros(I.size), td[J], pd[K])
+    ok = (wi[:, 2] > cos_max) & (wo[:, 2] > cos_max)
+    if isinstance(model, MERLBRDF):
+        v = np.moveaxis(model.table[:, I, J, K], 0, -1)
+        ok &= (v >= 0).all(axis=-1)
+        idx = np.flatnonzero(ok)
+        fv = np.ascontiguousarray(v[idx], dtype=np.float64)
+    else:
+        idx = np.flatnonzero(ok)
+        fv = np.asarray(model.eval(wi[idx], wo[idx]), dtype=np.float64)
+    if idx.size < 16:
+        raise ValueError(f"{_source_label(model)}: too few measured bins within {max_theta_deg}° ({idx.size})")
+    if not np.isfinite(fv).all():
+        raise ValueError(f"{_source_label(model)}: measured values are not finite")
+    u = (I[idx] + 0.5) / RES_THETA_H
+    w = np.sin(th[I[idx]]) * (np.pi * u) * np.sin(td[J[idx]]) * np.cos(td[J[idx]])
+    return Samples(np.ascontiguousarray(wi[idx]), np.ascontiguousarray(wo[idx]), fv, w / w.mean(),
+                   _source_label(model))
+
+
+def subsample(data: Samples, n: int, seed: int = 0) -> Samples:
+    """A uniformly random subset of ``n`` of ``data``'s samples, weights kept (renormalised to mean 1):
+    the same integral estimated from fewer points, for the multi-start search of a table-scale fit."""
+    if n >= len(data):
+        return data
+    rng = np.random.default_rng(seed)
+    idx = np.sort(rng.choice(len(data), size=n, replace=False))
+    w = data.w[idx]
+    return Samples(data.wi[idx], data.wo[idx], data.f[idx], w / w.mean(), data.source)
+
+
 def _transform(metric: str) -> Callable[[np.ndarray, np.ndarray], np.ndarray]:
     if metric == "ngan":
         return lambda f, c: f * c
@@ -229,7 +275,10 @@ def _bounds(p: Param) -> tuple[float, float, bool]:
 
 
 # Anisotropic models fitted to isotropic data: these pairs share one free value.
-ISOTROPIC_TIES = (("alpha_x", "alpha_y"), ("nu", "nv"), ("n_u", "n_v"), ("alpha_u", "alpha_v"), ("m_x", "m_y"))
+_TIES = (("alpha_x", "alpha_y"), ("nu", "nv"), ("n_u", "n_v"), ("alpha_u", "alpha_v"), ("m_x", "m_y"),
+         ("cx_1", "cy_1"), ("cx_2", "cy_2"), ("cx_3", "cy_3"))
+#: the pairs, also for a second lobe's parameters (``lobes=2``: names with the suffix ``_2``)
+ISOTROPIC_TIES = _TIES + tuple((a + "_2", b + "_2") for a, b in _TIES[:5])
 
 
 class ParamPacker:
@@ -333,6 +382,52 @@ class ParamPacker:
         return xs
 
 
+# --------------------------------------------------------------------------- two lobes
+#: parameters that belong to the diffuse part of a model (a second lobe has none)
+DIFFUSE_PARAMS = ("kd", "rd")
+_TWO_LOBE: dict[type, type] = {}
+
+
+def two_lobe(cls: type[BRDF]) -> type[BRDF]:
+    """``cls`` plus a second specular lobe of the same form (Ngan et al. 2005's two-lobe fits).
+
+    The class's parameters are ``cls``'s plus a copy ``<name>_2`` of every fitted scalar/rgb
+    parameter except the diffuse ones (:data:`DIFFUSE_PARAMS`); options (choices, bools) are
+    shared. ``eval`` is ``cls(params) + cls(params_2 with kd = rd = 0)``: the first term keeps
+    the diffuse part, the second is one more lobe. (The Lafortune model has lobes of its own:
+    ``fit(..., lobes=2)`` sets its ``lobes`` parameter instead.)
+    """
+    if cls in _TWO_LOBE:
+        return _TWO_LOBE[cls]
+    from dataclasses import replace
+
+    second = tuple(replace(p, name=p.name + "_2", doc=f"{p.doc} (second lobe)") for p in cls.spec
+                   if p.name not in DIFFUSE_PARAMS and p.kind in ("scalar", "rgb") and p.fit)
+    base_names = tuple(p.name for p in cls.spec)
+    zero_diffuse = {p.name: 0.0 for p in cls.spec if p.name in DIFFUSE_PARAMS}
+
+    class TwoLobe(BRDF):
+        name = cls.name + "+lobe2"
+        title = f"{cls.name} with a second specular lobe"
+        reference = cls.reference
+        isotropic = cls.isotropic
+        spec = tuple(cls.spec) + second
+        base = cls
+
+        def _setup(self) -> None:
+            p = self.params
+            one = {k: p[k] for k in base_names}
+            two = dict(one, **zero_diffuse, **{q.name[:-2]: p[q.name] for q in second})
+            self.lobe1, self.lobe2 = cls(**one), cls(**two)
+
+        def _eval(self, wi, wo, p):
+            return self.lobe1.eval(wi, wo) + self.lobe2.eval(wi, wo)
+
+    TwoLobe.__name__ = TwoLobe.__qualname__ = cls.__name__ + "TwoLobe"
+    _TWO_LOBE[cls] = TwoLobe
+    return TwoLobe
+
+
 # --------------------------------------------------------------------------- the fit
 @dataclass
 class FitResult:
@@ -351,6 +446,9 @@ class FitResult:
     unused: list[str] = field(default_factory=list)
     start_errors: list[float] = field(default_factory=list)
     n_free: int = 0
+    at_bound: list[str] = field(default_factory=list)
+    lobes: int = 1
+    search_samples: int = 0
 
     def to_json(self) -> dict[str, Any]:
         return {
@@ -364,7 +462,11 @@ class FitResult:
             "unused": self.unused,
             "free_values": self.n_free,
             "samples": self.samples,
+            "search_samples": self.search_samples or self.samples,
+            "lobes": self.lobes,
             "starts": self.starts,
+            "start_errors": [float(e) for e in self.start_errors],
+            "at_bound": self.at_bound,
             "nfev": self.nfev,
             "seconds": round(self.seconds, 3),
         }
@@ -376,6 +478,22 @@ class FitResult:
         from ..interchange.notebook import fit_html
 
         return fit_html(self)
+
+
+#: a fitted value within this fraction of its (optimiser-space) range of a bound counts as "at the bound"
+AT_BOUND_TOL = 1e-4
+
+
+def _at_bound(packer: "ParamPacker", x: np.ndarray) -> list[str]:
+    """The free values that ended on a fitting bound: ``name`` or ``name[channel]``, with ``=lo``/``=hi``."""
+    out = []
+    span = packer.ub - packer.lb
+    for s, xv, lo, hi, sp in zip(packer.slots, x, packer.lb, packer.ub, span):
+        side = "lo" if xv - lo <= AT_BOUND_TOL * sp else "hi" if hi - xv <= AT_BOUND_TOL * sp else None
+        if side:
+            label = s.param.name if s.channel is None else f"{s.param.name}[{s.channel}]"
+            out.append(f"{label}={side}")
+    return out
 
 
 def _freeze_unused(packer: ParamPacker, residuals, rng: np.random.Generator) -> None:
@@ -396,6 +514,86 @@ def _freeze_unused(packer: ParamPacker, residuals, rng: np.random.Generator) -> 
         packer.freeze(unused)
 
 
+#: samples of the multi-start search of a ``samples="table"`` fit (the polish runs on every bin)
+TABLE_SEARCH_SAMPLES = 3000
+
+
+def _residual_fn(packer: "ParamPacker", data: Samples, T):
+    c = data.cos_i[:, None]
+    target = T(data.f, c)
+    sw = np.sqrt(data.w)[:, None]
+    scale = 1.0 / math.sqrt(target.size)
+
+    def residuals(x: np.ndarray) -> np.ndarray:
+        f = np.asarray(packer.model(x).eval(data.wi, data.wo), np.float64)
+        return (sw * (T(f, c) - target)).ravel() * scale
+
+    return residuals
+
+
+def _local(residuals, x0, packer, max_nfev, tol):
+    from scipy.optimize import least_squares
+
+    x0 = np.clip(x0, packer.lb, packer.ub)
+    # least_squares needs x0 strictly inside the bounds
+    eps = 1e-9 * np.maximum(1.0, packer.ub - packer.lb)
+    x0 = np.minimum(np.maximum(x0, packer.lb + eps), packer.ub - eps)
+    return least_squares(
+        residuals, x0, bounds=(packer.lb, packer.ub), method="trf", x_scale="jac", tr_solver="lsmr",
+        max_nfev=max_nfev, xtol=tol, ftol=tol, gtol=tol,
+    )
+
+
+#: Levenberg-Marquardt iterations of the table-scale polish
+POLISH_ITERATIONS = 4
+
+
+def _polish(residuals, x, packer: "ParamPacker", iterations: int = POLISH_ITERATIONS) -> tuple[np.ndarray, int]:
+    """A few bounded Levenberg-Marquardt steps on a large residual vector (every table bin).
+
+    ``least_squares`` would hold the whole (residuals × parameters) Jacobian and run LSMR
+    on it (2.7 M × 10 for a table: seconds per iteration); here the forward-difference
+    columns are reduced at once to the normal equations JᵀJ (n × n) and Jᵀr, and a step is
+    kept only if it lowers the cost, so the result is never worse than the start.
+    Returns ``(x, evaluations)``."""
+    n = len(x)
+    r = residuals(x)
+    cost = float(r @ r)
+    used, lam = 1, 1e-3
+    for _ in range(iterations):
+        J = np.empty((n, r.size), np.float32)  # forward-difference columns, as rows
+        for i in range(n):
+            h = 1e-6 * max(1.0, abs(float(x[i])))
+            if x[i] + h > packer.ub[i]:
+                h = -h
+            y = x.copy()
+            y[i] += h
+            J[i] = (residuals(y) - r) / h
+            used += 1
+        JtJ = (J @ J.T).astype(np.float64)
+        Jtr = (J @ r.astype(np.float32)).astype(np.float64)
+        del J
+        improved = False
+        for _try in range(6):
+            A = JtJ + lam * np.diag(np.maximum(np.diag(JtJ), 1e-30))
+            try:
+                step = -np.linalg.solve(A, Jtr)
+            except np.linalg.LinAlgError:
+                lam *= 10
+                continue
+            y = np.clip(x + step, packer.lb, packer.ub)
+            ry = residuals(y)
+            used += 1
+            cy = float(ry @ ry)
+            if cy < cost:
+                x, r, cost, lam, improved = y, ry, cy, max(lam / 10, 1e-9), True
+                break
+            lam *= 10
+        if not improved:
+            break
+    return x, used
+
+
 def fit(
     name: str | type[BRDF],
     measured: Any,
@@ -404,7 +602,8 @@ def fit(
     *,
     starts: int = 4,
     candidates: int = 48,
-    samples: int = 3000,
+    samples: int | str = 3000,
+    lobes: int = 1,
     seed: int = 0,
     max_theta_deg: float = 80.0,
     max_nfev: int | None = None,
@@ -416,13 +615,16 @@ def fit(
 
     ``measured``: a MERL file path, a built-in material name (``"merl/chrome"``) or a
     model (e.g. :func:`brdfkit.load_merl`'s). ``fixed``: parameters held at the given
-    values. ``metric``: one of :data:`METRICS`. ``starts``: local optimisations run
-    (from the defaults and the best of ``candidates`` random points). ``data``:
-    precomputed :func:`sample` output (then ``measured`` only names the source).
-    Returns a :class:`FitResult` (``params`` holds every parameter of the model).
+    values. ``metric``: one of :data:`METRICS`. ``samples``: the number of weighted
+    samples (:func:`sample`), or ``"table"``: every measured bin (:func:`table`); then the
+    multi-start search runs on :data:`TABLE_SEARCH_SAMPLES` of them and the best start is
+    polished on all. ``lobes``: 1, or 2 for a second specular lobe (:func:`two_lobe`;
+    Lafortune: its own ``lobes``). ``starts``: local optimisations run (from the defaults
+    and the best of ``candidates`` random points). ``data``: precomputed :func:`sample` or
+    :func:`table` output (then ``measured`` only names the source).
+    Returns a :class:`FitResult` (``params`` holds every parameter of the model;
+    ``at_bound`` lists the free values that ended on a fitting bound).
     """
-    from scipy.optimize import least_squares
-
     from .. import registry
 
     t0 = time.perf_counter()
@@ -430,19 +632,27 @@ def fit(
         raise ValueError(f"unknown metric {metric!r}; valid metrics: {', '.join(METRICS)}")
     if starts < 1:
         raise ValueError(f"starts must be at least 1, got {starts}")
+    is_table = isinstance(samples, str)
+    if is_table and samples != "table":
+        raise ValueError(f"samples must be a number of samples or 'table', got {samples!r}")
+    if not is_table and (isinstance(samples, bool) or not isinstance(samples, (int, np.integer))):
+        raise ValueError(f"samples must be a number of samples or 'table', got {samples!r}")
+    if isinstance(lobes, bool) or lobes not in (1, 2):
+        raise ValueError(f"lobes must be 1 or 2, got {lobes!r}")
     cls = name if isinstance(name, type) and issubclass(name, BRDF) else registry.get(name)
+    fixed = dict(fixed or {})
+    if lobes == 2:
+        if any(p.name == "lobes" for p in cls.spec):
+            fixed.setdefault("lobes", 2)
+        else:
+            cls = two_lobe(cls)
     packer = ParamPacker(cls, fixed)
     if data is None:
-        data = sample(measured, n=samples, seed=seed, max_theta_deg=max_theta_deg)
+        data = table(measured, max_theta_deg) if is_table else sample(measured, n=samples, seed=seed,
+                                                                      max_theta_deg=max_theta_deg)
+    search = subsample(data, TABLE_SEARCH_SAMPLES, seed) if is_table else data
     T = _transform(metric)
-    c = data.cos_i[:, None]
-    target = T(data.f, c)
-    sw = np.sqrt(data.w)[:, None]
-    scale = 1.0 / math.sqrt(target.size)
-
-    def residuals(x: np.ndarray) -> np.ndarray:
-        f = np.asarray(packer.model(x).eval(data.wi, data.wo), np.float64)
-        return (sw * (T(f, c) - target)).ravel() * scale
+    residuals = _residual_fn(packer, search, T)
 
     def cost(x: np.ndarray) -> float:
         r = residuals(x)
@@ -450,11 +660,11 @@ def fit(
 
     nfev = 0
     if len(packer) == 0:  # nothing free: just evaluate
-        x_best = np.zeros(0)
-        err = math.sqrt(cost(x_best))
-        model = packer.model(x_best)
+        model = packer.model(np.zeros(0))
+        err = error(model, data, metric)
         return FitResult(model, dict(model.params), err, metric, data.source, len(data), 0, 1,
-                         time.perf_counter() - t0, sorted(packer.fixed_names), [], [err])
+                         time.perf_counter() - t0, sorted(packer.fixed_names), [], [err], lobes=lobes,
+                         search_samples=len(search))
     # from here on the model is built from the free values
     rng = np.random.default_rng(seed + 1)
     nfev += 2 * (len(packer) + 1)  # _freeze_unused: at most 2 points × (base + one probe per slot)
@@ -468,7 +678,7 @@ def fit(
     order = [0] + [int(i) for i in np.argsort(costs) if i != 0]
     chosen = order[:starts]
 
-    total = len(chosen)
+    total = len(chosen) + (1 if search is not data else 0)
     bar_ctx = None
     callback = progress if callable(progress) else None
     if progress is True:
@@ -482,19 +692,10 @@ def fit(
         task = bar_ctx.add_task("fit", total=total)
     best_x, best_cost = None, math.inf
     start_errors = []
-    iters: list[int] = []
     try:
         for n_done, ci in enumerate(chosen, 1):
-            x0 = np.clip(cand[ci], packer.lb, packer.ub)
-            # least_squares needs x0 strictly inside the bounds
-            eps = 1e-9 * np.maximum(1.0, packer.ub - packer.lb)
-            x0 = np.minimum(np.maximum(x0, packer.lb + eps), packer.ub - eps)
-            res = least_squares(
-                residuals, x0, bounds=(packer.lb, packer.ub), method="trf", x_scale="jac", tr_solver="lsmr",
-                max_nfev=max_nfev or 100, xtol=tol, ftol=tol, gtol=tol,
-            )
+            res = _local(residuals, cand[ci], packer, max_nfev or 100, tol)
             nfev += int(res.nfev) + int(res.njev or 0) * len(packer)
-            iters.append(int(res.nfev))
             cst = float(2 * res.cost)
             start_errors.append(math.sqrt(cst))
             if cst < best_cost:
@@ -503,15 +704,22 @@ def fit(
                 bar_ctx.update(task, advance=1)
             if callback is not None:
                 callback(n_done, total)
+        if search is not data:  # polish the best start on every bin
+            best_x, used = _polish(_residual_fn(packer, data, T), best_x, packer)
+            nfev += used
+            if bar_ctx is not None:
+                bar_ctx.update(task, advance=1)
+            if callback is not None:
+                callback(total, total)
     finally:
         if bar_ctx is not None:
             bar_ctx.stop()
     model = packer.model(best_x)
     err = error(model, data, metric)
     return FitResult(
-        model, dict(model.params), err, metric, data.source, len(data), total, nfev,
+        model, dict(model.params), err, metric, data.source, len(data), len(chosen), nfev,
         time.perf_counter() - t0, sorted(packer.fixed_names), list(packer.frozen), start_errors,
-        len(packer),
+        len(packer), _at_bound(packer, best_x), lobes, len(search),
     )
 
 
@@ -544,12 +752,14 @@ def fit_batch(
         for n_src, src in enumerate(sources, 1):
             if log_lines:
                 print(f"[{n_src}/{len(sources)}] {src} ({time.perf_counter() - t0:.0f} s)", file=sys.stderr, flush=True)
-            data = sample(src, n=n_samp, **samp_kw)
+            data = (table(src, samp_kw.get("max_theta_deg", 80.0)) if n_samp == "table"
+                    else sample(src, n=n_samp, **samp_kw))
             for nm in names:
                 bar.update(task, description=f"{nm:>18} ← {data.source}")
-                out.append(fit(nm, src, fixed=fixed.get(nm), metric=metric, data=data, seed=samp_kw.get("seed", 0), **kw))
+                out.append(fit(nm, src, fixed=fixed.get(nm), metric=metric, data=data, samples=n_samp,
+                               seed=samp_kw.get("seed", 0), **kw))
                 bar.update(task, advance=1)
     return out
 
 
-__all__ = ["fit", "fit_batch", "FitResult", "Samples", "sample", "error", "METRICS", "METRIC_TITLES", "ParamPacker"]
+__all__ = ["fit", "fit_batch", "FitResult", "Samples", "sample", "table", "subsample", "two_lobe", "error", "METRICS", "METRIC_TITLES", "ParamPacker"]

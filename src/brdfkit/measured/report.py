@@ -17,13 +17,13 @@ maps to 1 and encoded with the sRGB transfer curve
 
 from __future__ import annotations
 
-import json
 import math
 import os
 from typing import Any
 
 import numpy as np
 
+from ..fileio import atomic_path, write_json, write_text
 from ..geometry import spherical_to_vector, vector_to_spherical
 
 SLICE_THETA_I_DEG = (20.0, 45.0, 70.0)
@@ -82,7 +82,8 @@ def write_report(result, measured, out_dir: str) -> dict[str, Any]:
     fig.suptitle(f"{result.source}: measured (solid) vs {fitted.name} fit (dashed), error {result.error:.4g} ({result.metric})")
     fig.tight_layout()
     slices = os.path.join(out_dir, "slices.png")
-    fig.savefig(slices)
+    with atomic_path(slices) as tmp:
+        fig.savefig(tmp, format="png")
     plt.close(fig)
 
     # -- spheres ---------------------------------------------------------------------
@@ -98,24 +99,26 @@ def write_report(result, measured, out_dir: str) -> dict[str, Any]:
         ax.axis("off")
     fig.tight_layout()
     spheres = os.path.join(out_dir, "spheres.png")
-    fig.savefig(spheres, facecolor="white")
+    with atomic_path(spheres) as tmp:
+        fig.savefig(tmp, format="png", facecolor="white")
     plt.close(fig)
 
     js = os.path.join(out_dir, "fit.json")
-    with open(js, "w") as fh:
-        json.dump(result.to_json(), fh, indent=2)
+    write_json(js, result.to_json(), indent=2)
     index = os.path.join(out_dir, "index.md")
     params = result.to_json()["params"]
-    with open(index, "w") as fh:
-        fh.write(f"# Fit of `{fitted.name}` to `{result.source}`\n\n")
-        fh.write(f"Error {result.error:.6g} (metric `{result.metric}`), {result.samples} samples, "
-                 f"{result.starts} starts, {result.seconds:.1f} s.\n\n")
-        fh.write("| parameter | value |\n|---|---|\n")
-        for k, v in params.items():
-            if isinstance(v, list):
-                v = ", ".join(f"{x:.4g}" for x in v)
-            elif isinstance(v, float):
-                v = f"{v:.4g}"
-            fh.write(f"| {k} | {v} |\n")
-        fh.write("\n![in-plane slices](slices.png)\n\n![spheres](spheres.png)\n")
+    lines = [f"# Fit of `{fitted.name}` to `{result.source}`", "",
+             f"Error {result.error:.6g} (metric `{result.metric}`), {result.samples} samples, "
+             f"{result.starts} starts, {result.seconds:.1f} s.", ""]
+    if getattr(result, "at_bound", None):
+        lines += ["At a fitting bound: " + ", ".join(result.at_bound) + ".", ""]
+    lines += ["| parameter | value |", "|---|---|"]
+    for k, v in params.items():
+        if isinstance(v, list):
+            v = ", ".join(f"{x:.4g}" for x in v)
+        elif isinstance(v, float):
+            v = f"{v:.4g}"
+        lines.append(f"| {k} | {v} |")
+    lines += ["", "![in-plane slices](slices.png)", "", "![spheres](spheres.png)"]
+    write_text(index, "\n".join(lines) + "\n")
     return {"index": index, "slices": slices, "spheres": spheres, "json": js}

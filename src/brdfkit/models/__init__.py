@@ -30,3 +30,4 @@ from . import ward  # noqa: F401,E402
 from . import schlick  # noqa: F401,E402
 from . import htsg  # noqa: F401,E402
 from . import ashikhmin_shirley  # noqa: F401,E402
+from . import lafortune  # noqa: F401,E402
