@@ -417,3 +417,13 @@ def test_crlf_line_ends_and_tabs():
     m = model_class(parse_brdf_text(text, name="crlf.brdf"))()
     wi, wo, _ = _vectors()
     np.testing.assert_array_equal(m.eval(wi, wo), bk.load_brdf(DATA / "ggx.brdf").eval(wi, wo))
+
+
+def test_a_brdf_file_model_is_fittable():
+    """Its GLSL runs in float32, so the fitter takes the file's finite-difference step (fit_diff_step):
+    fitting ggx.brdf to the microfacet model it spells recovers that model's parameters."""
+    src = bk.model("microfacet", alpha=0.3, fresnel="schlick", f0=0.9, kd=0)
+    r = bk.fit(str(DATA / "ggx.brdf"), src, samples=400)
+    assert r.params["alpha"] == pytest.approx(0.3, rel=1e-3)
+    assert np.allclose(r.params["f0"], 0.9, rtol=1e-3)
+    assert np.all(np.asarray(r.params["kd"]) < 1e-3)

@@ -538,9 +538,12 @@ def _local(residuals, x0, packer, max_nfev, tol):
     # least_squares needs x0 strictly inside the bounds
     eps = 1e-9 * np.maximum(1.0, packer.ub - packer.lb)
     x0 = np.minimum(np.maximum(x0, packer.lb + eps), packer.ub - eps)
+    # a model evaluated in float32 (a .brdf file's GLSL) declares a finite-difference step its
+    # values can resolve; scipy's default (~1e-8 relative) would see no change at all
+    diff_step = getattr(packer.cls, "fit_diff_step", None)
     return least_squares(
         residuals, x0, bounds=(packer.lb, packer.ub), method="trf", x_scale="jac", tr_solver="lsmr",
-        max_nfev=max_nfev, xtol=tol, ftol=tol, gtol=tol,
+        max_nfev=max_nfev, xtol=tol, ftol=tol, gtol=tol, diff_step=diff_step,
     )
 
 
