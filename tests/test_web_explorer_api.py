@@ -211,17 +211,3 @@ def test_environment_maps_and_samplers(server):
     status, body = get_json(server, "/api/ibl/sampler?" + q)
     ref = ibl.sampler_uniforms(bk.model("microfacet", alpha=0.3, distribution="beckmann"))
     assert status == 200 and body["bki_lobe"] == ref["bki_lobe"] and np.allclose(body["bki_lobe_params"], ref["bki_lobe_params"])
-
-
-def test_derived_uniforms(server):
-    status, body = get_json(server, "/api/derived")
-    assert status == 200 and body["models"] == getattr(glsl, "DERIVED_UNIFORMS", {})
-    for name in body["models"]:
-        q = urlencode({"model": name, "params": "{}"})
-        status, got = get_json(server, "/api/derived?" + q)
-        ref = glsl.uniform_values(bk.model(name))
-        assert status == 200 and set(got["uniforms"]) == set(body["models"][name])
-        for k, v in got["uniforms"].items():
-            assert np.allclose(v, ref[k])
-    status, got = get_json(server, "/api/derived?" + urlencode({"model": "lambert", "params": "{}"}))
-    assert status == 200 and got["uniforms"] == {}

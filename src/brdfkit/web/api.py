@@ -42,9 +42,6 @@ Endpoints (all local; nothing here reaches outside the machine):
 ``GET /api/envs``, ``GET /api/env?name=NAME``, ``GET /api/ibl/sampler?model=NAME&params=JSON``
     the built-in environment maps; one map as the renderer's IBL textures (binary, see
     :func:`env_payload`); a model's importance-sampling uniforms for ``ibl.glsl``.
-``GET /api/derived[?model=NAME&params=JSON]``
-    the uniforms a model's GLSL needs beyond one per parameter (the microfacet model's
-    multiple-scattering table), computed by :func:`brdfkit.render.glsl.uniform_values`.
 ``GET /api/validate?model=NAME&params=JSON``
     ``{"ok": true, "params"}`` or ``{"ok": false, "error"}`` (always status 200).
 ``GET /api/albedo?model=NAME&params=JSON&n=K``
@@ -453,33 +450,6 @@ def ibl_sampler(query: dict, body: bytes):
 
     m = web_model(name, params)
     return _json(_jsonable(ibl.sampler_uniforms(m)))
-
-
-# ---------------------------------------------------------------------------
-# derived uniforms (uniforms a model's GLSL declares beyond one per parameter)
-# ---------------------------------------------------------------------------
-@route("GET", "/api/derived")
-def derived_uniforms(query: dict, body: bytes):
-    """Without ``model``: ``{"models": {name: {uniform: type}}}`` (glsl.DERIVED_UNIFORMS);
-    with ``model`` and ``params``: ``{"uniforms": {name: value}}`` from glsl.uniform_values."""
-    _only(query, {"model", "params"})
-    import brdfkit as bk
-    from ..render import glsl
-    from .server import _jsonable
-
-    table = getattr(glsl, "DERIVED_UNIFORMS", {})
-    if "model" not in query:
-        return _json({"models": table})
-    name = _one(query, "model")
-    try:
-        params = json.loads(_one(query, "params", "{}"))
-    except json.JSONDecodeError as e:
-        raise ValueError(f"params: not valid JSON ({e.msg})") from None
-    if not isinstance(params, dict):
-        raise ValueError("params: must be a JSON object")
-    values = glsl.uniform_values(web_model(name, params))
-    names = table.get(name, {})
-    return _json({"uniforms": _jsonable({k: v for k, v in values.items() if k in names})})
 
 
 # ---------------------------------------------------------------------------

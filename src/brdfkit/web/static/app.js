@@ -332,38 +332,6 @@ void main() {
     }
   }
 
-  // uniforms computed on the server from the parameters (glsl.DERIVED_UNIFORMS: the
-  // microfacet model's multiple-scattering table), cached per parameter set
-  let derivedModels = {};
-  const derivedCache = {};
-  const derivedKey = (name, params) => name + JSON.stringify(params || {});
-  async function ensureDerived(name, params) {
-    if (!derivedModels[name]) return;
-    const key = derivedKey(name, params);
-    if (derivedCache[key] && derivedCache[key].u) return;
-    const q = new URLSearchParams({ model: name, params: JSON.stringify(params || {}) });
-    const b = await fetchJSON("/api/derived?" + q.toString());
-    derivedCache[key] = { u: b.uniforms };
-  }
-  function setDerived(prog, name, params) {
-    if (!derivedModels[name]) return;
-    const key = derivedKey(name, params);
-    const hit = derivedCache[key];
-    if (!hit) {
-      derivedCache[key] = { pending: true };
-      ensureDerived(name, params).then(scheduleDraw).catch((e) => showError(`${name}: ${e.message}`));
-      return;
-    }
-    if (!hit.u) return;
-    for (const [u, v] of Object.entries(hit.u)) {
-      const type = derivedModels[name][u];
-      if (Array.isArray(v) && type === "float") gl.uniform1fv(U(prog, u + "[0]") || U(prog, u), v);
-      else if (type === "vec3") gl.uniform3fv(U(prog, u), v);
-      else if (type === "int") gl.uniform1i(U(prog, u), v);
-      else gl.uniform1f(U(prog, u), v);
-    }
-  }
-
   // bind what a BRDF needs: its parameters, its network weights or its table
   function bindMaterial(prog, name, params) {
     const k = kindOf(name);
@@ -371,7 +339,6 @@ void main() {
       const info = infoOf(name);
       const eff = effectiveParams(info, params);
       setModelUniforms(prog, info, eff);
-      if (k === "analytic") setDerived(prog, name, params);
     } else if (k === "nbrdf") {
       const w = nbrdfWeights[name];
       if (!w) throw new Error(`measured material '${name}' is not loaded yet`);
@@ -1962,7 +1929,6 @@ void main() {
       fetchJSON("/api/models").then((b) => b.models), fetchJSON("/api/measured").then((b) => b.materials), fetchJSON("/api/opengl")]);
     measuredNames = measured;
     openglTable = gltab;
-    try { derivedModels = (await fetchJSON("/api/derived")).models; } catch (e) { derivedModels = {}; }
     const files = ["pipeline_lights.glsl", "pipeline_vertex.glsl", "pipeline_fragment.glsl", "pipeline_brdf.glsl", "opengl_fixed.glsl"];
     const texts = await Promise.all(files.map((f) => fetchText("/api/glsl?file=" + f)));
     files.forEach((f, i) => { shaderFiles[f] = texts[i]; });
@@ -2049,7 +2015,6 @@ void main() {
         const q = JSON.stringify(params || {});
         if (!validatedCache.has(name + q)) { await validated(name, params || {}); validatedCache.add(name + q); }
       }
-      if (kindOf(name) === "analytic") await ensureDerived(name, params || {});
       const f = evaluateGPU(name, params || {}, norm(a), norm(b));
       const out = [];
       for (let k = 0; k < f.length; k += 3) out.push([f[k], f[k + 1], f[k + 2]]);
