@@ -64,3 +64,15 @@ def test_names_still_work(srv):
     assert json.loads(body)["value"][0] == pytest.approx(0.5 / 3.141592653589793, rel=1e-12)
     status, body = _get(srv, "/api/eval?model=" + quote("merl/chrome", safe="") + "&wi=0,0,1&wo=0,0,1")
     assert status == 200 and min(json.loads(body)["value"]) > 0
+
+
+@pytest.mark.parametrize("route", ["/api/validate", "/api/albedo", "/api/ibl/sampler", "/api/eval"])
+def test_deeply_nested_params_are_a_client_error(srv, route):
+    deep = quote("[" * 5000 + "]" * 5000, safe="")
+    dirs = "&wi=0,0,1&wo=0,0,1" if route == "/api/eval" else ""
+    status, body = _get(srv, f"{route}?model=lambert&params={deep}{dirs}")
+    assert status in (200, 400)
+    doc = json.loads(body)
+    assert "nested deeper" in (doc.get("error") or "")
+    if status == 200:
+        assert doc["ok"] is False

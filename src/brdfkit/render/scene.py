@@ -52,6 +52,7 @@ from typing import Any, Mapping
 import numpy as np
 
 from .. import opengl
+from ..jsonsafe import nesting_exceeds
 from .camera import camera_matrices
 from .image import TONEMAPS, save_image, to_display, to_uint8
 from .meshes import BUILTIN, Mesh, mesh_from_spec
@@ -331,7 +332,7 @@ def read_scene_file(path: str | os.PathLike) -> dict[str, Any]:
         text = p.read_bytes().decode("utf-8")
     except UnicodeDecodeError as e:
         raise ValueError(f"scene file {p} is not UTF-8 text (byte {e.start})") from None
-    if _too_deep(text, MAX_DEPTH):
+    if nesting_exceeds(text, MAX_DEPTH):
         raise ValueError(f"scene file {p} nests JSON deeper than {MAX_DEPTH} levels")
     try:
         obj = json.loads(text)
@@ -342,28 +343,6 @@ def read_scene_file(path: str | os.PathLike) -> dict[str, Any]:
     if not isinstance(obj, dict):
         raise ValueError("a scene must be a JSON object")
     return obj
-
-
-def _too_deep(text: str, limit: int) -> bool:
-    """Whether the brackets of JSON ``text`` nest deeper than ``limit`` (strings skipped)."""
-    depth, in_str, esc = 0, False, False
-    for ch in text:
-        if in_str:
-            if esc:
-                esc = False
-            elif ch == "\\":
-                esc = True
-            elif ch == '"':
-                in_str = False
-        elif ch == '"':
-            in_str = True
-        elif ch in "[{":
-            depth += 1
-            if depth > limit:
-                return True
-        elif ch in "]}":
-            depth -= 1
-    return False
 
 
 def load_scene(path: str | os.PathLike) -> tuple[Scene, Look]:

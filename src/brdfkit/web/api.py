@@ -79,6 +79,16 @@ def _refuse(name) -> None:
     raise ValueError(f"unknown model {shown!r}; valid models: {', '.join(bk.models())} or a built-in measured material")
 
 
+def _params(query: dict) -> dict:
+    """The ``params`` query value: a JSON object (the server's depth-checked parser), ``{}`` if absent."""
+    from .server import _loads
+
+    params = _loads(_one(query, "params", "{}") or "{}", "params", 'give a JSON object like {"kd": 0.5}')
+    if not isinstance(params, dict):
+        raise ValueError('params: must be a JSON object like {"kd": 0.5}')
+    return params
+
+
 def web_model_class(name: str):
     """The registry class a web request names; a file path or unknown name is a one-line ValueError."""
     import brdfkit as bk
@@ -440,12 +450,7 @@ def ibl_sampler(query: dict, body: bytes):
     from .server import _jsonable
 
     name = _one(query, "model")
-    try:
-        params = json.loads(_one(query, "params", "{}"))
-    except json.JSONDecodeError as e:
-        raise ValueError(f"params: not valid JSON ({e.msg})") from None
-    if not isinstance(params, dict):
-        raise ValueError("params: must be a JSON object")
+    params = _params(query)
     from ..measured import nbrdf
 
     m = web_model(name, params)
@@ -466,13 +471,7 @@ def validate_payload(query: dict, body: bytes):
 
     name = _one(query, "model")
     try:
-        params = json.loads(_one(query, "params", "{}"))
-    except json.JSONDecodeError as e:
-        return _json({"ok": False, "error": f"params: not valid JSON ({e.msg})"})
-    if not isinstance(params, dict):
-        return _json({"ok": False, "error": "params: must be a JSON object like {\"kd\": 0.5}"})
-    try:
-        m = web_model(name, params)
+        m = web_model(name, _params(query))
     except ValueError as e:
         return _json({"ok": False, "error": str(e).strip().splitlines()[0]})
     return _json({"ok": True, "params": _jsonable(to_jsonable(m.params))})
@@ -488,12 +487,7 @@ def albedo_payload(query: dict, body: bytes):
     from ..analysis import albedo
 
     name = _one(query, "model")
-    try:
-        params = json.loads(_one(query, "params", "{}"))
-    except json.JSONDecodeError as e:
-        raise ValueError(f"params: not valid JSON ({e.msg})") from None
-    if not isinstance(params, dict):
-        raise ValueError("params: must be a JSON object like {\"kd\": 0.5}")
+    params = _params(query)
     text = _one(query, "n", "30")
     try:
         n = int(text)

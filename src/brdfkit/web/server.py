@@ -72,6 +72,8 @@ from urllib.parse import parse_qs, unquote, urlsplit
 
 import numpy as np
 
+from ..jsonsafe import nesting_exceeds
+
 STATIC_DIR = Path(__file__).resolve().with_name("static")
 MAX_PAIRS = 100_000
 MAX_BODY = 1 << 20  # bytes of a request body
@@ -204,32 +206,10 @@ def eval_payload(query: dict[str, list[str]]) -> dict[str, Any]:
     }
 
 
-def _json_depth_ok(text: str, limit: int) -> bool:
-    """Whether the brackets in JSON ``text`` nest at most ``limit`` deep (strings skipped)."""
-    depth, in_str, esc = 0, False, False
-    for ch in text:
-        if in_str:
-            if esc:
-                esc = False
-            elif ch == "\\":
-                esc = True
-            elif ch == '"':
-                in_str = False
-        elif ch == '"':
-            in_str = True
-        elif ch in "[{":
-            depth += 1
-            if depth > limit:
-                return False
-        elif ch in "]}":
-            depth -= 1
-    return True
-
-
 def _loads(text: str, what: str, hint: str = "") -> Any:
     """``json.loads`` for query values: a one-line :class:`BadRequest` for bad or too deeply nested JSON."""
     hint = f"; {hint}" if hint else ""
-    if not _json_depth_ok(text, MAX_JSON_DEPTH):
+    if nesting_exceeds(text, MAX_JSON_DEPTH):
         raise BadRequest(f"{what}: JSON nested deeper than {MAX_JSON_DEPTH} levels{hint}")
     try:
         return json.loads(text)
