@@ -134,7 +134,7 @@ def test_dask_cluster_with_a_worker_killed_mid_batch_equals_local(cluster, refer
     try:
         t0 = time.time()
         fits = out / "fits"
-        while time.time() - t0 < 60 and p.poll() is None:
+        while time.time() - t0 < 300 and p.poll() is None:
             if fits.is_dir() and len(list(fits.glob("*.json"))) >= 1:
                 break
             time.sleep(0.02)
@@ -142,7 +142,7 @@ def test_dask_cluster_with_a_worker_killed_mid_batch_equals_local(cluster, refer
         assert p.poll() is None, p.communicate()[1].decode()[-2000:]
         _kill_group(workers[0])  # the worker and its nanny: its tasks in flight are lost
         assert 1 <= n_at_kill < 12, f"the kill came too late to test anything ({n_at_kill} of 12 done)"
-        stdout, stderr = p.communicate(timeout=90)
+        stdout, stderr = p.communicate(timeout=300)
     finally:
         _kill_group(p)
     assert p.returncode == 0, stderr.decode()[-2000:]
@@ -159,7 +159,7 @@ def test_resume_after_a_crash_completes_the_identical_table(reference, tmp_path)
     try:
         t0 = time.time()
         fits = out / "fits"
-        while time.time() - t0 < 60 and p.poll() is None:
+        while time.time() - t0 < 300 and p.poll() is None:
             if fits.is_dir() and len(list(fits.glob("*.json"))) >= 3:
                 break
             time.sleep(0.02)
@@ -170,7 +170,7 @@ def test_resume_after_a_crash_completes_the_identical_table(reference, tmp_path)
     assert 3 <= len(kept) < 12, f"{len(kept)} fits at the crash"
     for f in kept:  # every file that exists is complete (atomic writes); no temp files are left as fits
         assert json.loads(f.read_text())["error"] > 0
-    r = subprocess.run(args + ["--resume", "--json"], capture_output=True, env=_env(), timeout=120)
+    r = subprocess.run(args + ["--resume", "--json"], capture_output=True, env=_env(), timeout=300)
     assert r.returncode == 0, r.stderr.decode()[-2000:]
     summary = json.loads(r.stdout)
     assert summary["skipped"] == len(kept) and summary["fitted"] == 12 - len(kept)
@@ -190,13 +190,13 @@ def test_interrupt_keeps_finished_fits_and_says_so(tmp_path):
                          preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     try:
         t0 = time.time()
-        while time.time() - t0 < 60 and p.poll() is None:
+        while time.time() - t0 < 300 and p.poll() is None:  # a cold numba cache compiles first
             if (out / "fits").is_dir() and len(list((out / "fits").glob("*.json"))) >= 2:
                 break
             time.sleep(0.02)
         assert p.poll() is None, "the batch ended before it could be interrupted"
         os.kill(p.pid, signal.SIGINT)
-        _, stderr = p.communicate(timeout=60)
+        _, stderr = p.communicate(timeout=300)
     finally:
         _kill_group(p)
     err = stderr.decode()
