@@ -16,6 +16,14 @@ result (0 where ``wi.z <= 0`` or ``wo.z <= 0``, clamped to ``lim``) stored in
 ``out``. The same pass records the smallest and largest SQUARED direction
 lengths and a NaN count per chunk into ``nrm`` (``(nchunks, 6)``: wi min, max,
 nan, wo min, max, nan) for the unit-direction check of ``BRDF.eval``.
+
+Calls of more than :data:`CHUNK` pairs run instead a driver generated per kernel AND
+choice combination (:data:`SPECIAL_TEMPLATE`, lazily, cached on disk): choices as a
+constant tuple, the kernel inlined, ``p`` as a tuple, a branch-free loop over flat
+views, and the unit check as a vectorisable count of pairs outside a safe band (exact
+statistics only when that count is not zero). LLVM vectorises that loop where the
+kernel calls no libm function (issue 9; README, "Speed"). Kernels whose ``p`` holds a
+table (longer than :data:`MAX_TUPLE`) keep the generic driver.
 """
 
 from __future__ import annotations
