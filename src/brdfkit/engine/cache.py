@@ -79,10 +79,20 @@ def in_cache_dir() -> Iterator[None]:
 JIT_OPTIONS = dict(cache=True, error_model="numpy", nogil=True)
 
 
-def jit(fn: Callable) -> Callable:
-    """Decorator for scalar terms and kernels: nopython, cached, ``error_model="numpy"``, no fastmath."""
+def jit(fn: Callable | None = None, *, inline: bool = False) -> Callable:
+    """Decorator for scalar terms and kernels: nopython, cached, ``error_model="numpy"``, no fastmath.
+
+    ``@jit(inline=True)`` also inlines the function into its numba callers (numba IR
+    inlining, ``inline="always"``): for the small dispatchers over a choice index
+    (``fresnel_of``, ``d_of``, ...), so that a driver compiled with constant choices
+    folds their branches away (LLVM's own inliner leaves a function called three
+    times per pair out of line).
+    """
+    if fn is None:
+        return lambda f: jit(f, inline=inline)
+    opts = dict(JIT_OPTIONS, inline="always") if inline else JIT_OPTIONS
     with in_cache_dir():
-        return numba.njit(**JIT_OPTIONS)(fn)
+        return numba.njit(**opts)(fn)
 
 
 class vectorize:

@@ -140,7 +140,7 @@ def fresnel_term(kind: str, c: np.ndarray, p: dict[str, Any], dtype) -> np.ndarr
     return np.ones(c.shape + (3,), dtype=dtype)
 
 
-@jit
+@jit(inline=True)
 def fresnel_of(kind, c, eta, k, f0):
     """F(c) for the ``fresnel`` choice index ``kind`` (one channel)."""
     if kind == CONDUCTOR:
@@ -152,7 +152,7 @@ def fresnel_of(kind, c, eta, k, f0):
     return 1.0
 
 
-@jit
+@jit(inline=True)
 def shadowing_of(kind, dist, wix, wiy, wiz, wox, woy, woz, hz, lh, vh, ax, ay):
     """G for the ``shadowing`` choice index ``kind``: separable Smith, height-correlated Smith, V-groove."""
     if kind == V_GROOVE:

@@ -179,7 +179,7 @@ BECKMANN = 0
 GGX = 1
 
 
-@jit
+@jit(inline=True)
 def d_of(dist, hx, hy, hz, ax, ay):
     """The normalised D of distribution index ``dist`` (:data:`BECKMANN` or :data:`GGX`)."""
     if dist == 0:
@@ -187,7 +187,7 @@ def d_of(dist, hx, hy, hz, ax, ay):
     return d_ggx(hx, hy, hz, ax, ay)
 
 
-@jit
+@jit(inline=True)
 def lambda_of(dist, wx, wy, wz, ax, ay):
     """The Smith Λ of distribution index ``dist``."""
     if dist == 0:

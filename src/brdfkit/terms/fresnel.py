@@ -62,7 +62,7 @@ def f_dielectric(c, n):
     return min(max(F, 0.0), 1.0)
 
 
-@jit
+@jit(inline=True)
 def f_conductor(c, eta, k):
     """Exact unpolarised Fresnel of a conductor, complex index ``η = eta + i·k``, at ``c = cos θ``.
 
