@@ -87,8 +87,8 @@ class Param:
 
     ``range`` is ``(lo, hi)`` (inclusive unless ``open_lo``/``open_hi``) for
     ``scalar``, ``rgb`` and ``int``; ``math.inf`` is allowed as ``hi``.
-    ``fit_range`` optionally narrows the range used as fitting bounds (e.g. a
-    shininess that may go to 1e6 but is fitted within [1, 1e4]).
+    ``fit_range`` optionally narrows the range used as fitting bounds (e.g. an
+    exponent that may be 0 but is fitted within [1, 1e5]).
     ``fit`` says whether the fitter may vary it (choices and bools never are).
     """
 

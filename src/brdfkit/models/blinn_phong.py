@@ -44,7 +44,7 @@ parameter   kind    default  range         meaning
 ==========  ======  =======  ============  ==========================================
 kd          rgb     0.5      [0, 1]        diffuse albedo (kd/π)
 ks          rgb     0.3      [0, 1]        specular weight
-shininess   scalar  32       [0, 1e5]      exponent s of (n·h)^s (fitted within [1, 1e4])
+shininess   scalar  32       [0, 1e5]      exponent s of (n·h)^s (fitted within [1, 1e5])
 normalized  bool    true     true | false  (s+8)/(8π) form, else the raw OpenGL term
                                            / cos θi
 ==========  ======  =======  ============  ==========================================

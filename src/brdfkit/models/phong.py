@@ -41,7 +41,7 @@ parameter   kind    default  range         meaning
 kd          rgb     0.5      [0, 1]        diffuse albedo (kd/π)
 ks          rgb     0.3      [0, 1]        specular weight (normalized: lobe albedo
                                            at normal incidence)
-shininess   scalar  32       [0, 1e5]      Phong exponent s (fitted within [1, 1e4])
+shininess   scalar  32       [0, 1e5]      Phong exponent s (fitted within [1, 1e5])
 normalized  bool    true     true | false  Lewis's (s+2)/(2π) form, else the raw
                                            lighting-equation term / cos θi
 ==========  ======  =======  ============  ==========================================
