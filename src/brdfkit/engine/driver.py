@@ -41,6 +41,7 @@ import numpy as np
 
 from ..fileio import write_text
 from .cache import cache_dir, in_cache_dir, jit
+from .evaluate import _sq_stats  # the exact length statistics, shared with the generic check
 
 CHUNK = 2048
 #: the specialised driver passes ``p`` as a tuple; kernels with longer ``p`` (tables) keep the generic one
@@ -297,23 +298,6 @@ def run(kernel: Callable, wi: np.ndarray, wo: np.ndarray, p: np.ndarray, c: np.n
     else:  # exact statistics (same formula as the generic driver), for check_unit and its message
         nrm[:] = [*_sq_stats(wi), *_sq_stats(wo)]
     return nrm
-
-
-@jit
-def _sq_stats(w):
-    """(min, max, NaN count) of the squared lengths of the rows of a C-contiguous ``(n, 3)`` array."""
-    lmin = math.inf
-    lmax = -math.inf
-    nan = 0
-    for j in range(w.shape[0]):
-        x = numba.float64(w[j, 0])
-        y = numba.float64(w[j, 1])
-        z = numba.float64(w[j, 2])
-        q = x * x + y * y + z * z
-        nan += q != q
-        lmin = min(lmin, q)
-        lmax = max(lmax, q)
-    return lmin, lmax, float(nan)
 
 
 __all__ = ["CHUNK", "TEMPLATE", "SPECIAL_TEMPLATE", "driver_for", "special_driver_for", "param_tuple", "run", "nchunks"]

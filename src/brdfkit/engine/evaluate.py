@@ -14,8 +14,8 @@ UNIT_TOL = {np.dtype(np.float64): 1e-4, np.dtype(np.float32): 1e-3}
 
 
 @jit
-def _length_stats(w):
-    """(min length, max length, NaN count) of the rows of a C-contiguous ``(n, 3)`` array."""
+def _sq_stats(w):
+    """(min, max, NaN count) of the squared lengths of the rows of a C-contiguous ``(n, 3)`` array."""
     lmin = math.inf
     lmax = -math.inf
     nan = 0
@@ -23,11 +23,18 @@ def _length_stats(w):
         x = numba.float64(w[j, 0])
         y = numba.float64(w[j, 1])
         z = numba.float64(w[j, 2])
-        n = x * x + y * y + z * z
-        nan += n != n
-        lmin = min(lmin, n)
-        lmax = max(lmax, n)
-    return math.sqrt(lmin), math.sqrt(lmax), nan
+        q = x * x + y * y + z * z
+        nan += q != q
+        lmin = min(lmin, q)
+        lmax = max(lmax, q)
+    return lmin, lmax, float(nan)
+
+
+@jit
+def _length_stats(w):
+    """(min length, max length, NaN count) of the rows of a C-contiguous ``(n, 3)`` array."""
+    qmin, qmax, nan = _sq_stats(w)
+    return math.sqrt(qmin), math.sqrt(qmax), int(nan)
 
 
 def _length_stats_np(w: np.ndarray) -> tuple[float, float, int]:
