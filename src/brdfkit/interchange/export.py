@@ -457,33 +457,42 @@ def _openpbr_direct(model: BRDF) -> tuple[dict[str, Any] | None, bool, str]:
     return None, False, ""
 
 
-def openpbr_params(model: BRDF, metric: str = "ngan", data=None) -> tuple[dict[str, Any], dict[str, Any]]:
-    """OpenPBR Surface parameters for a model, and what went into them."""
-    from .targets import OpenPBRSurface
-
-    direct, exact, note = _openpbr_direct(model)
+def _target_params(target, what: str, direct_fn, model: BRDF, metric: str, data, fixed_fn=None):
+    """A target material's parameters for ``model``: the direct mapping ``direct_fn(model)`` where
+    it is exact; otherwise fitted to the target's formula (:mod:`.targets`) from the direct mapping
+    (or the defaults), keeping whichever is closer. ``fixed_fn(full)`` gives parameters held fixed."""
+    direct, exact, note = direct_fn(model)
     info: dict[str, Any] = {"exact": exact, "error": None, "relative_error": None, "method": "direct", "note": note}
-    full = {p.name: p.validate("openpbr", p.default) for p in OpenPBRSurface.spec}
+    full = {p.name: p.validate(target.name, p.default) for p in target.spec}
     if direct is not None:
         full.update({k: (np.asarray(v) if isinstance(v, list) else v) for k, v in direct.items()})
     if exact:
         return to_jsonable(full), info
     data = data if data is not None else _samples(model)
-    start = OpenPBRSurface(**full)
-    e0, r0 = _errors(start.eval(data.wi, data.wo), data, metric)
-    fixed = {"base_weight": 1.0}
-    if _is_isotropic(model):
-        fixed["specular_roughness_anisotropy"] = full["specular_roughness_anisotropy"]
-    r = _fit(OpenPBRSurface, model, data, metric, fixed, start=full)
+    e0, r0 = _errors(target(**full).eval(data.wi, data.wo), data, metric)
+    r = _fit(target, model, data, metric, fixed_fn(full) if fixed_fn else {}, start=full)
     e1, r1 = _errors(r.model.eval(data.wi, data.wo), data, metric)
     if direct is None or e1 < e0:
         full = dict(r.params)
         info.update(method="fit", error=e1, relative_error=r1,
-                    note=(note + "; " if note else "") + "fitted to the OpenPBR formula (brdfkit.interchange.targets)")
+                    note=(note + "; " if note else "") + f"fitted to {what} (brdfkit.interchange.targets)")
         info["fit"] = r.to_json()
     else:
         info.update(error=e0, relative_error=r0)
     return to_jsonable(full), info
+
+
+def openpbr_params(model: BRDF, metric: str = "ngan", data=None) -> tuple[dict[str, Any], dict[str, Any]]:
+    """OpenPBR Surface parameters for a model, and what went into them."""
+    from .targets import OpenPBRSurface
+
+    def fixed(full):
+        out = {"base_weight": 1.0}
+        if _is_isotropic(model):
+            out["specular_roughness_anisotropy"] = full["specular_roughness_anisotropy"]
+        return out
+
+    return _target_params(OpenPBRSurface, "the OpenPBR formula", _openpbr_direct, model, metric, data, fixed)
 
 
 _SS_NAMES = {  # OpenPBR -> Standard Surface
@@ -572,25 +581,7 @@ def gltf_params(model: BRDF, metric: str = "ngan", data=None) -> tuple[dict[str,
     """glTF metallic-roughness (+ior, +specular) parameters for a model, and what went into them."""
     from .targets import GltfPBR
 
-    direct, exact, note = _gltf_direct(model)
-    info: dict[str, Any] = {"exact": exact, "error": None, "relative_error": None, "method": "direct", "note": note}
-    full = {p.name: p.validate("gltf", p.default) for p in GltfPBR.spec}
-    if direct is not None:
-        full.update({k: (np.asarray(v) if isinstance(v, list) else v) for k, v in direct.items()})
-    if exact:
-        return to_jsonable(full), info
-    data = data if data is not None else _samples(model)
-    e0, r0 = _errors(GltfPBR(**full).eval(data.wi, data.wo), data, metric)
-    r = _fit(GltfPBR, model, data, metric, {}, start=full)
-    e1, r1 = _errors(r.model.eval(data.wi, data.wo), data, metric)
-    if direct is None or e1 < e0:
-        full = dict(r.params)
-        info.update(method="fit", error=e1, relative_error=r1,
-                    note=(note + "; " if note else "") + "fitted to the glTF BRDF (brdfkit.interchange.targets)")
-        info["fit"] = r.to_json()
-    else:
-        info.update(error=e0, relative_error=r0)
-    return to_jsonable(full), info
+    return _target_params(GltfPBR, "the glTF BRDF", _gltf_direct, model, metric, data)
 
 
 def uv_sphere(n_lat: int = 32, n_lon: int = 64) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

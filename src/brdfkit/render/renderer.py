@@ -531,10 +531,10 @@ class Renderer:
             out = self._draw(prog, scene, scene.size, 0, attachments=3)
         return tuple(np.ascontiguousarray(a[::-1]) for a in out)  # type: ignore[return-value]
 
-    def _render_ibl_numpy(self, scene: Scene) -> np.ndarray:
-        """The brute-force numpy reference (:func:`brdfkit.render.ibl.reference_shade`) on a G-buffer."""
-        from .ibl import reference_shade
-
+    def _shade_gbuffer(self, scene: Scene, shade) -> np.ndarray:
+        """Per-pixel shading in numpy: a G-buffer (2× supersampled with ``antialias``), then
+        ``shade(P, N, T)`` (eye-space positions, normals, tangents of the covered pixels, float64)
+        -> RGB, averaged back to ``scene.size``. Shared by the numpy Phong path and the IBL reference."""
         ss = 2 if scene.antialias else 1
         w, h = scene.size
         prog = self._program("none", "gbuffer", scene.shading)
@@ -543,14 +543,19 @@ class Renderer:
         cover = pos[..., 3] > 0
         img = np.zeros((h * ss, w * ss, 4), np.float64)
         if cover.any():
-            img[cover, :3] = reference_shade(
-                scene.material, pos[cover][:, :3], nrm[cover][:, :3], tan[cover][:, :3], scene.modelview,
-                scene.environment,
-            )
+            img[cover, :3] = shade(*(a[cover][:, :3].astype(np.float64) for a in (pos, nrm, tan)))
             img[cover, 3] = 1.0
         if ss > 1:
             img = img.reshape(h, ss, w, ss, 4).mean(axis=(1, 3))
         return img.astype(np.float32)
+
+    def _render_ibl_numpy(self, scene: Scene) -> np.ndarray:
+        """The brute-force numpy reference (:func:`brdfkit.render.ibl.reference_shade`) on a G-buffer."""
+        from .ibl import reference_shade
+
+        return self._shade_gbuffer(
+            scene, lambda P, N, T: reference_shade(scene.material, P, N, T, scene.modelview, scene.environment)
+        )
 
     def _render_numpy(self, scene: Scene) -> np.ndarray:
         from .lighting import shade_points
@@ -569,27 +574,9 @@ class Renderer:
             samples = MSAA_SAMPLES if scene.antialias else 0
             return self._draw(prog, scene, scene.size, samples, colors=colors)[0]
         # phong: G-buffer, then per-pixel lighting in numpy
-        ss = 2 if scene.antialias else 1
-        w, h = scene.size
-        prog = self._program("none", "gbuffer", scene.shading)
-        self._set_common(prog, scene)
-        pos, nrm, tan = self._draw(prog, scene, (w * ss, h * ss), 0, attachments=3)
-        cover = pos[..., 3] > 0
-        img = np.zeros((h * ss, w * ss, 4), np.float64)
-        if cover.any():
-            rgb = shade_points(
-                scene.material,
-                pos[cover][:, :3].astype(np.float64),
-                nrm[cover][:, :3].astype(np.float64),
-                tan[cover][:, :3].astype(np.float64),
-                scene.lights,
-                scene.light_model,
-            )
-            img[cover, :3] = rgb
-            img[cover, 3] = 1.0
-        if ss > 1:
-            img = img.reshape(h, ss, w, ss, 4).mean(axis=(1, 3))
-        return img.astype(np.float32)
+        return self._shade_gbuffer(
+            scene, lambda P, N, T: shade_points(scene.material, P, N, T, scene.lights, scene.light_model)
+        )
 
 
 def _over_environment(img: np.ndarray, scene: Scene) -> np.ndarray:
