@@ -27,6 +27,11 @@ SETTINGS = dict(samples=600, starts=3, seed=0)
 CLI_ARGS = ["--set", "nielsen", "--limit", "4", "--samples", "600", "--starts", "3"]
 
 
+def _fits(folder):
+    """The finished fit files: an atomic write in flight is a hidden ``.NAME.*.tmp.json`` beside them."""
+    return sorted(f for f in folder.glob("*.json") if not f.name.startswith("."))
+
+
 def _env() -> dict[str, str]:
     env = dict(os.environ)
     env["PYTHONPATH"] = SRC + os.pathsep + env.get("PYTHONPATH", "")
@@ -80,7 +85,7 @@ def test_local_batch_tables(reference):
     recs = _records(reference)
     assert len(recs) == 12 and all(r["samples"] == 600 and "at_bound" in r for r in recs.values())
     # one file per fit, each a complete JSON object
-    assert len(list((reference / "fits").glob("*.json"))) == 12
+    assert len(list(_fits(reference / "fits"))) == 12
     md = (reference / "fit_errors.md").read_text()
     assert "| **mean rank** |" in md and ("fitting bound" in md)
     for png in ("fit_errors_sorted.png", "fit_errors_by_material.png"):
@@ -135,10 +140,10 @@ def test_dask_cluster_with_a_worker_killed_mid_batch_equals_local(cluster, refer
         t0 = time.time()
         fits = out / "fits"
         while time.time() - t0 < 300 and p.poll() is None:
-            if fits.is_dir() and len(list(fits.glob("*.json"))) >= 1:
+            if fits.is_dir() and len(list(_fits(fits))) >= 1:
                 break
             time.sleep(0.02)
-        n_at_kill = len(list(fits.glob("*.json")))
+        n_at_kill = len(list(_fits(fits)))
         assert p.poll() is None, p.communicate()[1].decode()[-2000:]
         _kill_group(workers[0])  # the worker and its nanny: its tasks in flight are lost
         assert 1 <= n_at_kill < 12, f"the kill came too late to test anything ({n_at_kill} of 12 done)"
@@ -160,13 +165,13 @@ def test_resume_after_a_crash_completes_the_identical_table(reference, tmp_path)
         t0 = time.time()
         fits = out / "fits"
         while time.time() - t0 < 300 and p.poll() is None:
-            if fits.is_dir() and len(list(fits.glob("*.json"))) >= 3:
+            if fits.is_dir() and len(list(_fits(fits))) >= 3:
                 break
             time.sleep(0.02)
         _kill_group(p)  # SIGKILL: a crash, nothing gets to clean up
     finally:
         _kill_group(p)
-    kept = sorted(fits.glob("*.json"))
+    kept = sorted(_fits(fits))
     assert 3 <= len(kept) < 12, f"{len(kept)} fits at the crash"
     for f in kept:  # every file that exists is complete (atomic writes); no temp files are left as fits
         assert json.loads(f.read_text())["error"] > 0
@@ -191,7 +196,7 @@ def test_interrupt_keeps_finished_fits_and_says_so(tmp_path):
     try:
         t0 = time.time()
         while time.time() - t0 < 300 and p.poll() is None:  # a cold numba cache compiles first
-            if (out / "fits").is_dir() and len(list((out / "fits").glob("*.json"))) >= 2:
+            if (out / "fits").is_dir() and len(list(_fits(out / "fits"))) >= 2:
                 break
             time.sleep(0.02)
         assert p.poll() is None, "the batch ended before it could be interrupted"
@@ -202,7 +207,7 @@ def test_interrupt_keeps_finished_fits_and_says_so(tmp_path):
     err = stderr.decode()
     assert p.returncode != 0 and "Traceback" not in err
     assert "interrupted" in err and "--resume" in err
-    n = len(list((out / "fits").glob("*.json")))
+    n = len(list(_fits(out / "fits")))
     assert n >= 2
     # the tables were written from what finished, with blank cells for the rest
     rows = (out / "fit_errors.csv").read_text().strip().splitlines()
