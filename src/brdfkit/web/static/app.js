@@ -17,6 +17,7 @@
   const status = {
     ready: false, webgl2: false, floatTargets: false, renderer: null,
     models: {}, error: null, frames: 0,
+    drawn: {},  // view -> how many times it was drawn (a setting redraws only the views it changes)
   };
   window.brdfkitStatus = status;
 
@@ -65,6 +66,7 @@
   };
   // IEC 61966-2-1 sRGB transfer functions (Python twin: brdfkit.render.image.srgb_encode).
   const srgbToLinear = (c) => (c <= 0.04045 ? c / 12.92 : Math.pow((c + 0.055) / 1.055, 2.4));
+  const srgbEncode = (c) => (c <= 0.0031308 ? 12.92 * c : 1.055 * Math.pow(c, 1 / 2.4) - 0.055);
   const linearToSrgb = (c) => (c <= 0.0031308 ? 12.92 * c : 1.055 * Math.pow(c, 1 / 2.4) - 0.055);
   const sph = (t, p) => [Math.sin(t) * Math.cos(p), Math.sin(t) * Math.sin(p), Math.cos(t)];
 
@@ -111,21 +113,23 @@ void main() {
 }
 `;
   const SRGB_GLSL = `
-float bkw_srgb1(float c) { return c <= 0.0031308 ? 12.92 * c : 1.055 * pow(c, 1.0 / 2.4) - 0.055; }
-vec3 bkw_srgb(vec3 c) { c = clamp(c, 0.0, 1.0); return vec3(bkw_srgb1(c.r), bkw_srgb1(c.g), bkw_srgb1(c.b)); }
+vec3 bkw_srgb(vec3 c) {  // one vector pow, not three scalar ones
+    c = clamp(c, 0.0, 1.0);
+    return mix(1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, 12.92 * c, lessThanEqual(c, vec3(0.0031308)));
+}
 `;
   const SPHERE_MAIN = `
 uniform vec4 bkw_viewport;     // x, y, w, h in pixels
 uniform vec3 bkw_light;        // unit, view space (viewer along +z)
 uniform float bkw_scale;       // light irradiance x 2^exposure
 uniform int bkw_tangent;       // 0: tangents along latitudes, 1: along longitudes
-uniform vec3 bkw_background;
+uniform vec3 bkw_background;  // sRGB-encoded (srgbEncode on the page)
 out vec4 bkw_color;
 ${SRGB_GLSL}
 void main() {
     vec2 p = ((gl_FragCoord.xy - bkw_viewport.xy) / bkw_viewport.zw * 2.0 - 1.0) * 1.06;
     float r2 = dot(p, p);
-    if (r2 >= 1.0) { bkw_color = vec4(bkw_srgb(bkw_background), 1.0); return; }
+    if (r2 >= 1.0) { bkw_color = vec4(bkw_background, 1.0); return; }
     vec3 n = vec3(p, sqrt(1.0 - r2));
     vec3 axis = bkw_tangent == 0 ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0);
     vec3 t = cross(axis, n);
@@ -140,7 +144,7 @@ void main() {
     vec3 c = brdf(wi, wo) * max(wi.z, 0.0) * bkw_scale;
     float r = sqrt(r2);
     float a = clamp((1.0 - r) / max(fwidth(r), 1e-6), 0.0, 1.0);
-    bkw_color = vec4(mix(bkw_srgb(bkw_background), bkw_srgb(c), a), 1.0);
+    bkw_color = vec4(mix(bkw_background, bkw_srgb(c), a), 1.0);
 }
 `;
   // θh × θd image at φd (Rusinkiewicz 1998, φh = 0): h = (sin θh, 0, cos θh); d in h's frame
@@ -191,7 +195,7 @@ void main() {
   let measuredNames = [];      // built-in measured materials
   const sources = {};          // source key -> GLSL text
   const programs = {};         // source key + "|" + kind -> WebGLProgram (or {error})
-  const nbrdfWeights = {};     // material -> Float32Array(676)
+  const nbrdfWeights = {};     // material -> Float32Array(844): u_nbrdf[211] of nbrdf.glsl
   const merlTables = {};       // loaded MERL file label -> {texture}
   const brdfFiles = {};        // loaded .brdf label -> {info, source key}
   let shaderFiles = {};        // pipeline_*.glsl etc.
@@ -253,9 +257,39 @@ void main() {
       reference: "", params: [] };
   }
 
-  // "eval" | "sphere" | "slice" | "obj-flat" | "obj-gouraud" | "obj-phong" | "gl-flat" ...
-  function getProgram(key, kind) {
-    const id = key + "|" + kind;
+  // The per-pixel views compile a model once per combination of its integer parameters
+  // (choices, booleans): their `uniform int u_x;` becomes `const int u_x = v;`, the rest of
+  // the model's GLSL unchanged, so the compiler drops the branches not taken. A software
+  // renderer (SwiftShader) otherwise runs every side of a branch on a uniform, tables of
+  // unused options included (microfacet's sphere at 750x750: 4.6 s -> 0.11 s a frame).
+  function intConstants(name, params) {
+    const k = kindOf(name);
+    if (k !== "analytic" && k !== "brdf") return null;
+    const info = infoOf(name);
+    const eff = effectiveParams(info, params);
+    const out = {};
+    for (const p of info.params) {
+      if (!p.uniform || p.uniform.type !== "int") continue;
+      const v = eff[p.name];
+      out[p.uniform.name] = p.kind === "choice" ? Math.max(0, p.choices.indexOf(v))
+        : p.kind === "bool" ? (v === true || v === 1 || v === "true" ? 1 : 0) : Math.round(+v);
+    }
+    return Object.keys(out).length ? out : null;
+  }
+  function sourceOf(key, consts) {
+    let src = sources[key];
+    if (src === undefined) throw new Error(`no GLSL source for '${key}'`);
+    for (const [n, v] of Object.entries(consts || {})) {
+      const re = new RegExp(`^uniform int ${n};`, "m");
+      src = src.replace(re, `const int ${n} = ${v};`);  // (a source without the line keeps its uniform)
+    }
+    return src;
+  }
+
+  // "eval" | "sphere" | "slice" | "obj-flat" | "obj-gouraud" | "obj-phong" | "gl-flat" ...;
+  // consts: intConstants(...) or null
+  function getProgram(key, kind, consts) {
+    const id = key + "|" + kind + (consts ? "|" + JSON.stringify(consts) : "");
     if (programs[id]) {
       if (programs[id].error) throw new Error(programs[id].error);
       return programs[id];
@@ -263,12 +297,11 @@ void main() {
     try {
       let prog;
       if (kind === "eval" || kind === "sphere" || kind === "slice") {
-        const src = sources[key];
-        if (src === undefined) throw new Error(`no GLSL source for '${key}'`);
+        const src = sourceOf(key, consts);
         const main = kind === "eval" ? EVAL_MAIN : kind === "sphere" ? SPHERE_MAIN : SLICE_MAIN;
         prog = compileProgram(VERT, src + main);
       } else {
-        prog = pipelineProgram(key, kind);
+        prog = pipelineProgram(key, kind, consts);
       }
       programs[id] = prog;
       return prog;
@@ -280,7 +313,7 @@ void main() {
 
   // The renderer's pipeline, assembled as brdfkit.render.renderer.Renderer._program does
   // (GLSL ES 3.00 instead of 3.30): kind = "obj-<shading>" (a BRDF) or "gl-<shading>" (fixed function).
-  function pipelineProgram(key, kind) {
+  function pipelineProgram(key, kind, consts) {
     const [what, shading] = kind.split("-");
     const F = shaderFiles;
     for (const f of ["pipeline_lights.glsl", "pipeline_vertex.glsl", "pipeline_fragment.glsl", "pipeline_brdf.glsl", "opengl_fixed.glsl"]) {
@@ -297,8 +330,7 @@ void main() {
     let body;
     if (what === "gl") body = F["pipeline_lights.glsl"] + F["opengl_fixed.glsl"];
     else {
-      const src = sources[key];
-      if (src === undefined) throw new Error(`no GLSL source for '${key}'`);
+      const src = sourceOf(key, consts);
       body = src.replace(/^#version[^\n]*\n/, "") + F["pipeline_lights.glsl"];
       if (what === "ibl") {
         if (F["ibl.glsl"] === undefined) throw new Error("this server has no image-based lighting shaders");
@@ -1029,13 +1061,18 @@ void main() {
   // ------------------------------------------------------------------------
   // drawing helpers
   // ------------------------------------------------------------------------
-  let drawPending = false;
-  function scheduleDraw() {
+  // the next frame draws every pane, or (drawOnly, a Set) only the views asked for
+  let drawPending = false, drawOnly = null;
+  function scheduleDraw(only) {
+    if (!drawPending) drawOnly = only ? new Set([only]) : null;
+    else if (drawOnly) { if (only) drawOnly.add(only); else drawOnly = null; }
     if (drawPending) return;
     drawPending = true;
-    requestAnimationFrame(() => { drawPending = false; draw(); });
+    requestAnimationFrame(() => { const o = drawOnly; drawPending = false; drawOnly = null; draw(false, o); });
   }
-  function changed() { updateOutputs(); updateURL(); scheduleDraw(); }
+  // a change of state; only: the one view it affects (the light of the lit sphere), else all
+  function changed(only) { updateOutputs(); updateURL(); scheduleDraw(typeof only === "string" ? only : null); }
+  const SPHERE_ONLY = new Set(["light-theta", "light-phi", "tangent"]);  // settings only the lit sphere reads
 
   function channelOf(f, k, ch) {
     const r = f[3 * k], g = f[3 * k + 1], b = f[3 * k + 2];
@@ -1398,14 +1435,18 @@ void main() {
     viewData.lobe3d = csvFrom(["theta_o_deg", "phi_o_deg"], [th, ph], evals, n);
   }
 
-  // a row of tiles, one per visible BRDF, in a canvas of the view's size
-  function tiles(canvas, count, aspect) {
-    const W = canvas.width, H = canvas.height;
+  // a row of square tiles, one per visible BRDF, each with a label line under it (LABEL_H),
+  // in a canvas of the view's width; the canvas's height follows the row (at most its height
+  // in index.html), so that no empty band is left below the tiles
+  const LABEL_H = 18;
+  function fitTiles(canvas, count) {
+    if (!canvas.dataset.maxHeight) canvas.dataset.maxHeight = String(canvas.height);
+    const W = canvas.width, H = +canvas.dataset.maxHeight;
     const n = Math.max(1, count);
-    let w = Math.floor(W / n), h = Math.floor(w / aspect);
-    if (h > H - 18) { h = H - 18; w = Math.floor(h * aspect); }
+    const w = Math.max(1, Math.min(Math.floor(W / n), H - LABEL_H));
+    if (canvas.height !== w + LABEL_H) canvas.height = w + LABEL_H;
     const x0 = Math.floor((W - n * w) / 2);
-    return Array.from({ length: n }, (_, i) => ({ x: x0 + i * w, y: 0, w, h }));
+    return Array.from({ length: n }, (_, i) => ({ x: x0 + i * w, y: 0, w, h: w }));
   }
 
   function lightDir() {
@@ -1417,8 +1458,9 @@ void main() {
     const canvas = canvasArg || canvasOf("sphere");
     const ctx = canvas.getContext("2d");
     const list = visiblePanels();
-    ctx.fillStyle = "#222"; ctx.fillRect(0, 0, canvas.width, canvas.height);
-    const T = tiles(canvas, list.length, 1);
+    const T = fitTiles(canvas, list.length);
+    const bgByte = Math.round(255 * srgbEncode(BACKGROUND));  // the spheres' own background, no band around them
+    ctx.fillStyle = `rgb(${bgByte}, ${bgByte}, ${bgByte})`; ctx.fillRect(0, 0, canvas.width, canvas.height);
     const size = T[0].w;
     glSize(size * list.length, size);
     gl.bindFramebuffer(gl.FRAMEBUFFER, null);
@@ -1427,14 +1469,15 @@ void main() {
     const scale = Math.PI * Math.pow(2, num("exposure"));
     list.forEach((panel, i) => {
       try {
-        const prog = getProgram(sourceKey(panel.model), "sphere");
+        const prog = getProgram(sourceKey(panel.model), "sphere", intConstants(panel.model, panel.params()));
         gl.useProgram(prog);
         gl.viewport(i * size, 0, size, size);
         gl.uniform4f(U(prog, "bkw_viewport"), i * size, 0, size, size);
         gl.uniform3f(U(prog, "bkw_light"), L[0], L[1], L[2]);
         gl.uniform1f(U(prog, "bkw_scale"), scale);
         gl.uniform1i(U(prog, "bkw_tangent"), parseInt(getSetting("tangent"), 10));
-        gl.uniform3f(U(prog, "bkw_background"), BACKGROUND, BACKGROUND, BACKGROUND);
+        const bg = srgbEncode(BACKGROUND);
+        gl.uniform3f(U(prog, "bkw_background"), bg, bg, bg);
         bindMaterial(prog, panel.model, panel.params());
         gl.drawArrays(gl.TRIANGLES, 0, 3);
       } catch (e) { reportDrawError(e); }
@@ -1451,8 +1494,8 @@ void main() {
     const canvas = canvasOf("slice");
     const ctx = canvas.getContext("2d");
     const list = visiblePanels();
+    const T = fitTiles(canvas, list.length);
     ctx.fillStyle = "#222"; ctx.fillRect(0, 0, canvas.width, canvas.height);
-    const T = tiles(canvas, list.length, 1);
     const size = T[0].w;
     glSize(size * list.length, size);
     gl.bindFramebuffer(gl.FRAMEBUFFER, null);
@@ -1472,7 +1515,7 @@ void main() {
           let m = 0; for (const x of f) m = Math.max(m, x);
           scale = m > 0 ? m * Math.pow(2, num("exposure")) : 1;
         }
-        const prog = getProgram(sourceKey(panel.model), "slice");
+        const prog = getProgram(sourceKey(panel.model), "slice", intConstants(panel.model, panel.params()));
         gl.bindFramebuffer(gl.FRAMEBUFFER, null);
         gl.useProgram(prog);
         gl.viewport(i * size, 0, size, size);
@@ -1578,7 +1621,7 @@ void main() {
       const i = parseInt(matSel.slice(5), 10);
       panel = visiblePanels()[i];
       if (!panel) return `no visible BRDF number ${i + 1}`;
-      prog = getProgram(sourceKey(panel.model), "obj-" + shading);
+      prog = getProgram(sourceKey(panel.model), "obj-" + shading, intConstants(panel.model, panel.params()));
       label = panel.model;
     }
     const ambientAlbedo = panel ? normalAlbedo(panel) : null; // (runs the eval program: before useProgram)
@@ -1700,7 +1743,7 @@ void main() {
       }
     }
     if (ibl.spp < iblMax()) {
-      const prog = getProgram(sourceKey(panel.model), "ibl-phong");
+      const prog = getProgram(sourceKey(panel.model), "ibl-phong", intConstants(panel.model, panel.params()));
       gl.bindFramebuffer(gl.FRAMEBUFFER, ibl.fbo);
       gl.viewport(0, 0, w, h);
       gl.clearColor(0, 0, 0, 0); gl.clearDepth(1);
@@ -1799,13 +1842,19 @@ void main() {
     lobe3d: drawLobe3D, polar: drawPolar, theta_h: () => drawHalfDiffPlot("theta_h"), theta_d: () => drawHalfDiffPlot("theta_d"),
     theta_v: drawThetaV, albedo: drawAlbedo, sphere: () => drawSphere(), slice: drawSlice, object: () => drawObject(),
   };
-  function drawView(name) { if (gl) DRAW[name](); }
+  function drawView(name) {
+    if (!gl) return;
+    DRAW[name]();
+    status.drawn[name] = (status.drawn[name] || 0) + 1;
+  }
 
-  function draw(onlyObject) {
+  // onlyObject: the progressive environment-lit object's next pass; views: a Set, or null for all
+  function draw(onlyObject, views) {
     if (!gl) return;
     updateOutputs();
-    ibl.pending = false;
-    for (const v of panes) if (!onlyObject || v === "object") drawView(v);
+    const list = panes.filter((v) => (views ? views.has(v) : (!onlyObject || v === "object")));
+    if (list.includes("object")) ibl.pending = false;  // (else a progressive object keeps its next pass)
+    for (const v of list) drawView(v);
     status.frames += 1;
     if (ibl.pending && panes.includes("object")) {  // progressive: another pass of the lit object next frame
       requestAnimationFrame(() => { if (!drawPending) draw(true); });
@@ -1830,7 +1879,7 @@ void main() {
         const nz = Math.sqrt(1 - r2);
         setSetting("light-theta", Math.round(Math.acos(nz) / DEG * 2) / 2);
         setSetting("light-phi", Math.round(((Math.atan2(py, px) / DEG + 360) % 360) * 2) / 2);
-        changed();
+        changed("sphere");
         return;
       }
     };
@@ -1960,8 +2009,9 @@ void main() {
     refreshObjectMaterials();
     for (const id of Object.keys(SETTINGS)) {
       DEFAULTS[id] = getSetting(id);
-      $("#" + id).addEventListener("input", changed);
-      $("#" + id).addEventListener("change", changed);
+      const only = SPHERE_ONLY.has(id) ? "sphere" : null;
+      $("#" + id).addEventListener("input", () => changed(only));
+      $("#" + id).addEventListener("change", () => changed(only));
     }
     $("#add-brdf").addEventListener("click", () => {
       const taken = new Set(panels.map((p) => p.model));
