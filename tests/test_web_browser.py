@@ -63,8 +63,11 @@ class Browser:
         self.errors: list[str] = []
         self.requests: list[str] = []
 
-    def page(self, query: str = ""):
-        pg = self.browser.new_page(viewport={"width": 1024, "height": 768}, accept_downloads=True)
+    def page(self, query: str = "", context=None):
+        """A new page in a new browser context (its own storage), or in ``context``."""
+        if context is None:
+            context = self.browser.new_context(viewport={"width": 1024, "height": 768}, accept_downloads=True)
+        pg = context.new_page()
         pg.on("pageerror", lambda e: self.errors.append(str(e)))
         pg.on("console", lambda m: self.errors.append(m.text) if m.type == "error" else None)
         pg.on("request", lambda r: self.requests.append(r.url))
@@ -676,6 +679,54 @@ def test_dropped_brdf_file_shows_and_equals_numpy(page):
     page.evaluate("window.brdfkit.redraw()")
     for view in ("sphere", "polar", "object"):
         assert _nonblank(render(page, view)), view
+
+
+def test_dropped_files_survive_a_reload(browser, page, tmp_path):
+    """A dropped MERL table, .brdf file and OBJ are kept in the browser's IndexedDB under their
+    SHA-256 and named in the URL: the URL in the same browser shows them again; in a browser
+    without them (a fresh profile: IndexedDB empty) the page says so."""
+    import hashlib
+
+    merl = tmp_path / "kept.binary"
+    bk.save_merl(bk.model("microfacet", alpha=0.3, fresnel="schlick", f0=[0.9, 0.5, 0.2], kd=0.05), merl)
+    obj = tmp_path / "pyramid.obj"
+    obj.write_text("v 0 0 1\nv 1 0 -1\nv -1 1 -1\nv -1 -1 -1\nf 1 2 3\nf 1 3 4\nf 1 4 2\nf 2 4 3\n")
+    paths = [merl, ROOT / "tests" / "data" / "ward.brdf", obj]
+    only(page, "lambert", {}, **{"obj-material": "brdf:0"})
+    page.set_input_files("#file-input", [str(p) for p in paths])
+    page.wait_for_function("(window.brdfkit.state().files || []).length === 3", timeout=90_000)
+    st = page.evaluate("window.brdfkit.state()")
+    assert {f["name"]: f["sha256"] for f in st["files"]} == {p.name: hashlib.sha256(p.read_bytes()).hexdigest() for p in paths}
+    assert [c["model"] for c in st["compare"]] == ["file:kept", "brdf:ward"] and st["view"]["obj-mesh"] == "uploaded"
+    query = page.evaluate("window.brdfkit.url()")
+    assert "files=" in query
+    wi, wo = _random_pairs(20, seed=5)
+    ref = _page_eval(page, "brdf:ward", {}, wi, wo)
+    # the same URL in the same browser (its IndexedDB): everything back
+    p2 = browser.page(query, context=page.context)
+    try:
+        assert p2.evaluate("window.brdfkit.errors()") == []
+        after = p2.evaluate("window.brdfkit.state()")
+        assert _comparable(after) == _comparable(st)
+        assert np.array_equal(_page_eval(p2, "brdf:ward", {}, wi, wo), ref)
+        p2.evaluate("window.brdfkit.panels.forEach(p => p.setVisible(p.model === 'file:kept'))")
+        p2.evaluate("window.brdfkit.redraw()")
+        assert p2.evaluate("window.brdfkit.data('sphere').models") == ["file:kept"]
+        assert _nonblank(render(p2, "sphere"))
+        assert _nonblank(render(p2, "object"))
+        assert "pyramid.obj: 4 triangles" in p2.locator("#object-note").inner_text()
+    finally:
+        p2.close()
+    # a browser that does not hold the files: a visible error per file, no silent fallback
+    p3 = browser.page(query)
+    try:
+        errors = p3.evaluate("window.brdfkit.errors()")
+        for p in paths:
+            assert any(p.name in e and "not stored in this browser" in e for e in errors), (p.name, errors)
+        assert "kept.binary" in p3.locator("#errors").inner_text()
+        assert p3.evaluate("window.brdfkit.state().model") == "lambert"  # the rest of the state applies
+    finally:
+        p3.close()
 
 
 def test_drop_event_loads_a_file(page):

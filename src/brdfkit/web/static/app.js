@@ -548,6 +548,78 @@ void main() {
     return label;
   }
 
+  async function loadObjFile(file) {
+    const m = await fetchJSON("/api/mesh", { method: "POST", body: await file.arrayBuffer() });
+    m.name = file.name;
+    uploadedMesh = meshBuffers(m);
+    $("#obj-mesh option[value=uploaded]").disabled = false;
+    return "obj";
+  }
+
+  // Dropped files survive a reload: their bytes are kept in IndexedDB under their SHA-256,
+  // the state (URL, saved view) names them ({name, sha256}); a state naming a file this
+  // browser no longer holds is an error on the page.
+  const FILE_KINDS = [[/\.(binary|bin)$/i, loadMerlFile], [/\.brdf$/i, loadBrdfFile], [/\.obj$/i, loadObjFile]];
+  const loadedFiles = {};  // what a file made (file:NAME, brdf:NAME, or "obj") -> {name, sha256}
+  const fileLoader = (name) => (FILE_KINDS.find(([re]) => re.test(name)) || [null, null])[1];
+  let idbOpen = null;
+  function idbStore(mode) {
+    if (!idbOpen) {
+      idbOpen = new Promise((resolve, reject) => {
+        if (!window.indexedDB) { reject(new Error("this browser has no IndexedDB")); return; }
+        const r = indexedDB.open("brdfkit-files", 1);
+        r.onupgradeneeded = () => r.result.createObjectStore("files");
+        r.onsuccess = () => resolve(r.result);
+        r.onerror = () => reject(new Error("IndexedDB: " + (r.error ? r.error.message : "cannot open")));
+      });
+      idbOpen.catch(() => { idbOpen = null; });
+    }
+    return idbOpen.then((db) => db.transaction("files", mode).objectStore("files"));
+  }
+  const idbRequest = (req) => new Promise((resolve, reject) => {
+    req.onsuccess = () => resolve(req.result);
+    req.onerror = () => reject(new Error("IndexedDB: " + (req.error ? req.error.message : "failed")));
+  });
+  async function sha256Hex(bytes) {
+    if (!(window.crypto && crypto.subtle)) throw new Error("no crypto.subtle (the page is not a secure context: use http://127.0.0.1 or localhost)");
+    const d = new Uint8Array(await crypto.subtle.digest("SHA-256", bytes));
+    return Array.from(d, (b) => b.toString(16).padStart(2, "0")).join("");
+  }
+  // load a dropped file's bytes into the page and keep them; -> the label of what it made
+  async function loadAndKeep(name, bytes) {
+    const label = await fileLoader(name)(new File([bytes], name));
+    try {
+      const sha256 = await sha256Hex(bytes);
+      await idbRequest((await idbStore("readwrite")).put({ name, bytes }, sha256));
+      loadedFiles[label] = { name, sha256 };
+    } catch (e) {
+      delete loadedFiles[label];
+      showError(`${name}: loaded, but not kept for a reload (${e.message})`);
+    }
+    return label;
+  }
+  // the files a state names, back from IndexedDB (a missing one: an error on the page)
+  async function restoreFiles(files, origin) {
+    if (!Array.isArray(files)) { showError(`${origin}: files must be a list of {"name", "sha256"}`); return; }
+    for (const f of files) {
+      const ok = f && typeof f.name === "string" && typeof f.sha256 === "string" && /^[0-9a-f]{64}$/.test(f.sha256);
+      if (!ok || !fileLoader(f.name)) { showError(`${origin}: bad files entry ${JSON.stringify(f)}`); continue; }
+      if (Object.values(loadedFiles).some((g) => g.sha256 === f.sha256 && g.name === f.name)) continue;
+      try {
+        const rec = await idbRequest((await idbStore("readonly")).get(f.sha256));
+        if (!rec) throw new Error("it is not stored in this browser (IndexedDB was cleared, or another browser or profile): drop the file again");
+        const label = await fileLoader(f.name)(new File([rec.bytes], f.name));
+        loadedFiles[label] = { name: f.name, sha256: f.sha256 };
+      } catch (e) { showError(`${origin}: dropped file '${f.name}' (sha256 ${f.sha256.slice(0, 12)}…): ${e.message}`); }
+    }
+  }
+  // the kept files the current state uses
+  function stateFiles(models) {
+    return Object.entries(loadedFiles)
+      .filter(([label]) => (label === "obj" ? getSetting("obj-mesh") === "uploaded" : models.includes(label)))
+      .map(([, f]) => ({ name: f.name, sha256: f.sha256 }));
+  }
+
   // ------------------------------------------------------------------------
   // the BRDF panels
   // ------------------------------------------------------------------------
@@ -844,7 +916,7 @@ void main() {
     const first = list[0];
     const view = {};
     for (const id of Object.keys(SETTINGS)) view[id] = getSetting(id);
-    return {
+    const st = {
       model: first ? first.model : null,
       params: first ? first.params() : {},
       visible: first ? first.visible : true,
@@ -853,6 +925,9 @@ void main() {
       view,
       orbit: JSON.parse(JSON.stringify(orbit)),
     };
+    const files = stateFiles(list.map((p) => p.model));
+    if (files.length) st.files = files;
+    return st;
   }
 
   function stateToURL(st) {
@@ -861,6 +936,7 @@ void main() {
     q.set("p", JSON.stringify(st.params));
     if (st.visible === false) q.set("hide", "1");
     if (st.compare.length) q.set("compare", JSON.stringify(st.compare));
+    if (st.files) q.set("files", JSON.stringify(st.files));
     const view = {};
     for (const [k, v] of Object.entries(st.view)) if (v !== DEFAULTS[k]) view[k] = v;
     view.panes = st.panes;
@@ -876,10 +952,11 @@ void main() {
   // URL query -> a state object (throws with a one-line message naming the bad part)
   function urlToState(search) {
     const q = new URLSearchParams(search);
-    const allowed = new Set(["model", "p", "compare", "view", "hide"]);
-    for (const k of q.keys()) if (!allowed.has(k)) throw new Error(`URL: unknown parameter '${k}'; allowed: model, p, compare, view`);
+    const allowed = new Set(["model", "p", "compare", "view", "hide", "files"]);
+    for (const k of q.keys()) if (!allowed.has(k)) throw new Error(`URL: unknown parameter '${k}'; allowed: model, p, compare, view, files`);
     const st = { model: q.get("model"), params: {}, compare: [], view: {}, visible: q.get("hide") !== "1" };
     if (q.has("p")) st.params = parseJSONParam(q.get("p"), "URL p");
+    if (q.has("files")) st.files = parseJSONParam(q.get("files"), "URL files");
     const c = q.get("compare");
     if (c) {
       if (c.trim().startsWith("[")) st.compare = parseJSONParam(c, "URL compare");
@@ -913,6 +990,7 @@ void main() {
   // apply a state object; every bad part is reported on the page, the rest still applied
   async function applyState(st, origin) {
     if (st === null || typeof st !== "object" || Array.isArray(st)) throw new Error(`${origin}: expected a JSON object`);
+    if (st.files !== undefined) await restoreFiles(st.files, origin);  // before the panels that use them
     const entries = [];
     if (st.model !== undefined && st.model !== null) entries.push({ model: st.model, params: st.params || {}, visible: st.visible !== false });
     if (st.compare !== undefined) {
@@ -1918,22 +1996,12 @@ void main() {
         let st;
         try { st = JSON.parse(await file.text()); } catch (e) { throw new Error(`${file.name}: not valid JSON (${e.message})`); }
         await applyState(st, file.name);
-      } else if (name.endsWith(".binary") || name.endsWith(".bin")) {
-        const label = await loadMerlFile(file);
-        addPanel(label, {});
-        changed();
-      } else if (name.endsWith(".brdf")) {
-        const label = await loadBrdfFile(file);
-        addPanel(label, {});
-        changed();
-      } else if (name.endsWith(".obj")) {
-        const m = await fetchJSON("/api/mesh", { method: "POST", body: await file.arrayBuffer() });
-        m.name = file.name;
-        uploadedMesh = meshBuffers(m);
-        const opt = $("#obj-mesh option[value=uploaded]");
-        opt.disabled = false;
-        setSetting("obj-mesh", "uploaded");
-        if (!panes.includes("object")) showView("object", 1);
+      } else if (fileLoader(name)) {
+        const label = await loadAndKeep(file.name, await file.arrayBuffer());
+        if (label === "obj") {
+          setSetting("obj-mesh", "uploaded");
+          if (!panes.includes("object")) showView("object", 1);
+        } else addPanel(label, {});
         changed();
       } else {
         throw new Error(`${file.name}: unknown file type; drop a .json view, a MERL .binary, a .brdf or an .obj`);
