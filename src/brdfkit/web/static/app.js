@@ -581,7 +581,7 @@ void main() {
     req.onerror = () => reject(new Error("IndexedDB: " + (req.error ? req.error.message : "failed")));
   });
   async function sha256Hex(bytes) {
-    if (!(window.crypto && crypto.subtle)) throw new Error("no crypto.subtle (the page is not a secure context: use http://127.0.0.1 or localhost)");
+    if (!(window.crypto && crypto.subtle)) throw new Error("no crypto.subtle (the page is not a secure context: open it as 127.0.0.1 or localhost)");
     const d = new Uint8Array(await crypto.subtle.digest("SHA-256", bytes));
     return Array.from(d, (b) => b.toString(16).padStart(2, "0")).join("");
   }
