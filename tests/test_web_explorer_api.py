@@ -53,10 +53,27 @@ def test_measured_list_and_weights(server):
     assert status == 200 and body["materials"] == list(nbrdf.materials()) and len(body["materials"]) == 159
     status, body = get_json(server, "/api/nbrdf?name=gold-metallic-paint")  # a bare name resolves
     assert status == 200 and body["name"] == "merl/gold-metallic-paint"
-    w = np.asarray(body["weights"], dtype=np.float32)
-    assert w.size == 676 and w[-1] == 0
-    layers = nbrdf.material("merl/gold-metallic-paint")._layers
-    assert np.array_equal(w[:675], np.concatenate([a.reshape(-1) for a in layers]))
+    w = np.asarray(body["weights"], dtype=np.float64)
+    assert w.size == 211 * 4
+    # the blocks read as nbrdf.glsl reads them (mat4 = 4 vec4 columns, M * v) give the numpy network
+    u = w.reshape(211, 4)
+
+    def m4(i):
+        return u[i:i + 4].T  # column c = u[i + c]
+
+    rng = np.random.default_rng(1)
+    th, td, pd = rng.uniform(0, np.pi / 2, 50), rng.uniform(0, np.pi / 2, 50), rng.uniform(0, np.pi, 50)
+    got = []
+    for a, b, c in zip(th, td, pd):
+        xa = np.array([np.sin(a), np.cos(a), np.sin(b) * np.cos(c), np.sin(b) * np.sin(c)])
+        x5 = np.cos(b)
+        h1 = [np.maximum(m4(6 * k) @ xa + u[6 * k + 4] * x5 + u[6 * k + 5], 0) for k in range(6)]
+        h2 = [np.maximum(u[180 + k] + sum(m4(36 + 24 * k + 4 * m) @ h1[m] for m in range(6)), 0) for k in range(6)]
+        z = u[210] + sum(m4(186 + 4 * m) @ h2[m] for m in range(6))
+        assert z[3] == 0
+        got.append(np.maximum(np.expm1(np.minimum(z[:3], 80)), 0))
+    ref = nbrdf.material("merl/gold-metallic-paint").eval_rusinkiewicz(th, td, pd)
+    assert np.allclose(got, ref, rtol=1e-12, atol=0)
 
 
 def test_shaders_for_measured_materials(server):
@@ -67,7 +84,7 @@ def test_shaders_for_measured_materials(server):
         assert text.startswith("#version 300 es\n") and "vec3 brdf(vec3 wi, vec3 wo)" in text
         if glsl.glslang_available():
             glsl.glslang_validate_source(text[len("#version 300 es\n"):])
-    assert "uniform vec4 u_nbrdf[169];" in request(server, "/api/nbrdf/shader")[2].decode()
+    assert "uniform vec4 u_nbrdf[211];" in request(server, "/api/nbrdf/shader")[2].decode()
 
 
 def test_glsl_files(server):

@@ -11,10 +11,10 @@ Endpoints (all local; nothing here reaches outside the machine):
 ``GET /api/measured``
     ``{"materials": [...]}``: the 159 built-in measured materials (``set/name``).
 ``GET /api/nbrdf?name=SET/NAME``
-    ``{"name", "weights"}``: the material's Neural-BRDF network as 675 float32
-    values in the order ``fc1`` (6×21, row-major), ``b1`` (21), ``fc2`` (21×21),
-    ``b2`` (21), ``fc3`` (21×3), ``b3`` (3), padded with one zero to 676 = 169 vec4
-    (``u_nbrdf[169]`` in ``render/shaders/nbrdf.glsl``).
+    ``{"name", "weights"}``: the material's Neural-BRDF network as 211 vec4
+    (844 float32) for ``u_nbrdf[211]`` in ``render/shaders/nbrdf.glsl``: the layers
+    cut into 4×4 blocks (column-major mat4, 21 units padded with zeros to 24) so
+    that the shader reads every weight at a constant index (:func:`nbrdf_weights`).
 ``GET /api/nbrdf/shader``
     GLSL ES 3.00 defining ``vec3 brdf(vec3 wi, vec3 wo)`` for a Neural-BRDF network
     (:func:`nbrdf_source`).
@@ -65,7 +65,8 @@ ROUTES: dict[tuple[str, str], Handler] = {}
 JSON = "application/json; charset=utf-8"
 TEXT = "text/plain; charset=utf-8"
 MAX_UPLOAD = 64 * 1024 * 1024  # a MERL file is 33 MB
-NBRDF_FLOATS = 6 * 21 + 21 + 21 * 21 + 21 + 21 * 3 + 3  # 675
+N_IN = 6
+NBRDF_VEC4 = 211  # u_nbrdf[211] in nbrdf.glsl (nbrdf_blocks)
 
 
 def _refuse(name) -> None:
@@ -178,17 +179,55 @@ def measured_list(query: dict, body: bytes):
     return _json({"materials": list(nbrdf.materials())})
 
 
+def nbrdf_blocks(fc1, b1, fc2, b2, fc3, b3) -> np.ndarray:
+    """A network's layers as the ``NBRDF_VEC4`` × 4 float32 values of ``u_nbrdf`` (nbrdf.glsl).
+
+    ``fc*`` are (inputs, units) as in the npz (x·W). Units are padded with zeros to 24 =
+    6 groups of 4; a mat4 is 4 vec4 columns, column c holding input c's weights to the
+    group's 4 units (GLSL's ``mat4 * vec4``). Layout, in vec4:
+
+    * ``[6k, 6k+6)``, group k of layer 1: a mat4 for the inputs (x0, x2, x3, x4), then
+      x5's column, then the bias (x1 = 0 contributes nothing);
+    * ``36 + 24k + 4m``: the mat4 from group m of layer 1 to group k of layer 2;
+      ``180 + k``: layer 2's bias;
+    * ``186 + 4m``: the mat4 from group m of layer 2 to the 3 outputs (+ a zero); ``210``: the bias.
+    """
+    def pad(a, rows, cols):
+        out = np.zeros((rows, cols), np.float32)
+        a = np.asarray(a, np.float32).reshape(a.shape[0], -1)
+        out[: a.shape[0], : a.shape[1]] = a
+        return out
+
+    w1, w2, w3 = pad(fc1, N_IN, 24), pad(fc2, 24, 24), pad(fc3, 24, 4)
+    v1, v2, v3 = pad(np.reshape(b1, (1, -1)), 1, 24)[0], pad(np.reshape(b2, (1, -1)), 1, 24)[0], pad(np.reshape(b3, (1, -1)), 1, 4)[0]
+    vec4: list[np.ndarray] = []
+    for k in range(6):  # layer 1: columns = inputs 0, 2, 3, 4, then 5, then the bias
+        g = slice(4 * k, 4 * k + 4)
+        vec4 += [w1[i, g] for i in (0, 2, 3, 4, 5)] + [v1[g]]
+    for k in range(6):  # layer 2
+        for m in range(6):
+            vec4 += [w2[4 * m + c, 4 * k:4 * k + 4] for c in range(4)]
+    vec4 += [v2[4 * k:4 * k + 4] for k in range(6)]
+    for m in range(6):  # layer 3
+        vec4 += [w3[4 * m + c] for c in range(4)]
+    vec4.append(v3)
+    flat = np.concatenate(vec4).astype(np.float32)
+    if flat.size != 4 * NBRDF_VEC4:
+        raise ValueError(f"unexpected network shape ({flat.size} floats, expected {4 * NBRDF_VEC4})")
+    return flat
+
+
 def nbrdf_weights(name: str) -> np.ndarray:
-    """The network of a built-in material as the 676 float32 values ``nbrdf.glsl`` reads."""
+    """The network of a built-in material as the 844 float32 values ``nbrdf.glsl`` reads."""
     from ..measured import nbrdf
 
     full = nbrdf.resolve(name)
     w = nbrdf._weights()
-    parts = [w[f"{full}/{k}"].astype(np.float32).reshape(-1) for k in ("fc1", "b1", "fc2", "b2", "fc3", "b3")]
-    flat = np.concatenate(parts + [np.zeros(1, np.float32)])
-    if flat.size != NBRDF_FLOATS + 1:
-        raise ValueError(f"{full}: unexpected network shape ({flat.size - 1} weights, expected {NBRDF_FLOATS})")
-    return flat
+    layers = [w[f"{full}/{k}"] for k in ("fc1", "b1", "fc2", "b2", "fc3", "b3")]
+    shapes = [(N_IN, 21), (21,), (21, 21), (21,), (21, 3), (3,)]
+    if [tuple(a.shape) for a in layers] != shapes:
+        raise ValueError(f"{full}: unexpected network shape {[a.shape for a in layers]}")
+    return nbrdf_blocks(*layers)
 
 
 @route("GET", "/api/nbrdf")

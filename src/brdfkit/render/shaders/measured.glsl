@@ -31,22 +31,20 @@ float bk_merl_atan2_upper(float y, float x) {
     return x < 0.0 ? BK_PI - r : r;
 }
 
-// (θh, θd, φd folded into [0, π)): the angles of merl.symmetric_half_diff,
-// rearranged to be well conditioned in float32 and bit-for-bit the same for
-// (wi, wo) and (wo, wi):
-//   θh = atan2(|h.xy|, h.z) (not acos(h.z), which loses the small angles near
-//   the specular peak), θd = atan2(|wi − wo|, |wi + wo|) (half the angle
-//   between wi and wo), and the difference direction from d = wi − wo rotated
-//   into the half-vector frame (the swap negates d exactly), not from the
-//   difference of the two rotated vectors.
-vec3 bk_merl_angles(vec3 wi, vec3 wo) {
+// The half/difference geometry of merl.symmetric_half_diff, rearranged to be
+// well conditioned in float32 and bit-for-bit the same for (wi, wo) and
+// (wo, wi): with s = wi + wo, d = wi − wo and h = s / |s|,
+//   q.x = sin θh = |h.xy|,  q.y = cos θh = h.z,
+//   q.zw = d rotated into the half-vector frame (x, y; its z is 0 for unit
+//          vectors), the sign chosen so that y > 0 (or y = 0, x >= 0): φd
+//          folded into [0, π) (the swap negates d exactly);
+//   |s| = 2 cos θd and |d| = 2 sin θd (bk_merl_lengths).
+// Not from angles: no acos(h.z), which loses the small θh near the specular peak.
+vec4 bk_merl_half_diff(vec3 wi, vec3 wo) {
     vec3 s = wi + wo;
     vec3 d = wi - wo;
-    float ls = length(s);
-    vec3 h = s / max(ls, 1e-30);
+    vec3 h = s / max(length(s), 1e-30);
     float r = length(h.xy);
-    float theta_h = bk_merl_atan2_upper(r, h.z);
-    float theta_d = bk_merl_atan2_upper(length(d), ls);
     float ch = r > 0.0 ? h.x / r : 1.0;    // cos φh
     float sh = r > 0.0 ? h.y / r : 0.0;    // sin φh
     // rotate d by −φh about z, then by −θh about y (cos θh = h.z, sin θh = r)
@@ -57,7 +55,19 @@ vec3 bk_merl_angles(vec3 wi, vec3 wo) {
         vx = -vx;
         vy = -vy;
     }
-    float phi_d = bk_merl_atan2_upper(vy, vx);
+    return vec4(r, h.z, vx, vy);
+}
+
+vec2 bk_merl_lengths(vec3 wi, vec3 wo) { return vec2(length(wi + wo), length(wi - wo)); }
+
+// (θh, θd, φd folded into [0, π)) from bk_merl_half_diff: atan2 throughout
+// (θd = atan2(|wi − wo|, |wi + wo|), half the angle between wi and wo)
+vec3 bk_merl_angles(vec3 wi, vec3 wo) {
+    vec4 q = bk_merl_half_diff(wi, wo);
+    vec2 l = bk_merl_lengths(wi, wo);
+    float theta_h = bk_merl_atan2_upper(q.x, q.y);
+    float theta_d = bk_merl_atan2_upper(l.y, l.x);
+    float phi_d = bk_merl_atan2_upper(q.w, q.z);
     // fold into [0, π): π (up to float32 rounding) is φd = 0
     if (phi_d >= BK_PI - 2.5e-7) phi_d = 0.0;
     return vec3(theta_h, theta_d, phi_d);

@@ -6,58 +6,50 @@
 //     x = (sin θh, 0, cos θh, sin θd cos φd, sin θd sin φd, cos θd)
 // through relu(x·W1 + b1) (21 units), relu(·W2 + b2) (21 units) and
 // max(exp(·W3 + b3) − 1, 0) to RGB f_r in 1/sr, φd folded into [0, π) as the
-// numpy model does. The angles are measured.glsl's bk_merl_angles (include
-// common.glsl, then measured.glsl with its table brdf() renamed, then this file:
-// brdfkit.web.api.nbrdf_source).
+// numpy model does. x is built from vectors, not angles (numpy takes sin/cos of
+// its float64 angles; float32 sin/cos of float32 angles would differ by ~1e-4
+// after the network): the half vector's (|h.xy|, h.z) and the difference
+// vector in the half-vector frame, measured.glsl's bk_merl_half_diff (include
+// common.glsl, then measured.glsl with its table brdf() renamed, then this
+// file: brdfkit.web.api.nbrdf_source).
 //
-// u_nbrdf holds the 675 weights in the order fc1 (6×21, row-major: input i,
-// unit j at 21 i + j), b1, fc2 (21×21), b2, fc3 (21×3), b3, plus one zero:
-// 169 vec4 (brdfkit.web.api.nbrdf_weights).
+// u_nbrdf holds the weights in 4x4 blocks (brdfkit.web.api.nbrdf_blocks: the
+// 21 units padded to 24 = 6 groups of 4), read only at constant indices (the
+// macros unroll the layers): a dynamic index into a uniform array costs a
+// gather per pixel in a software renderer.
 
-uniform vec4 u_nbrdf[169];
+uniform vec4 u_nbrdf[211];
 
-const int BK_NB_B1 = 126;
-const int BK_NB_W2 = 147;
-const int BK_NB_B2 = 588;
-const int BK_NB_W3 = 609;
-const int BK_NB_B3 = 672;
+#define BK_NB_M4(i) mat4(u_nbrdf[i], u_nbrdf[(i) + 1], u_nbrdf[(i) + 2], u_nbrdf[(i) + 3])
+// layer 1, group k: inputs (x0, x2, x3, x4) = xa, x5, bias
+#define BK_NB_L1(k) max(BK_NB_M4(6 * (k)) * xa + u_nbrdf[6 * (k) + 4] * x5 + u_nbrdf[6 * (k) + 5], 0.0)
+// layer 2, group k, from the 6 groups a0..a5 of layer 1
+#define BK_NB_L2(k) max(u_nbrdf[180 + (k)] + BK_NB_M4(36 + 24 * (k)) * a0 + BK_NB_M4(40 + 24 * (k)) * a1 \
+    + BK_NB_M4(44 + 24 * (k)) * a2 + BK_NB_M4(48 + 24 * (k)) * a3 + BK_NB_M4(52 + 24 * (k)) * a4 \
+    + BK_NB_M4(56 + 24 * (k)) * a5, 0.0)
 
-float bk_nb_w(int i) { return u_nbrdf[i >> 2][i & 3]; }
+// exp(t) − 1 without the cancellation of exp(t) − 1 for small |t| (expm1):
+// Taylor to t^8 below 1/4 (truncation < 1e-9 relative), else exp
+vec3 bk_nb_expm1(vec3 t) {
+    vec3 p = t * (1.0 + t * (1.0 / 2.0 + t * (1.0 / 6.0 + t * (1.0 / 24.0 + t * (1.0 / 120.0
+        + t * (1.0 / 720.0 + t * (1.0 / 5040.0 + t * (1.0 / 40320.0))))))));
+    return mix(exp(t) - 1.0, p, lessThan(abs(t), vec3(0.25)));
+}
 
-vec3 bk_nbrdf_eval(vec3 a) {
-    float sh = sin(a.x), chh = cos(a.x);
-    float sd = sin(a.y), cd = cos(a.y);
-    float x[6];
-    x[0] = sh; x[1] = 0.0; x[2] = chh;
-    x[3] = sd * cos(a.z); x[4] = sd * sin(a.z); x[5] = cd;
-    float h1[21];
-    for (int j = 0; j < 21; ++j) {
-        float s = bk_nb_w(BK_NB_B1 + j);
-        for (int i = 0; i < 6; ++i) s += x[i] * bk_nb_w(21 * i + j);
-        h1[j] = max(s, 0.0);
-    }
-    float h2[21];
-    for (int j = 0; j < 21; ++j) {
-        float s = bk_nb_w(BK_NB_B2 + j);
-        for (int i = 0; i < 21; ++i) s += h1[i] * bk_nb_w(BK_NB_W2 + 21 * i + j);
-        h2[j] = max(s, 0.0);
-    }
-    vec3 z;
-    for (int c = 0; c < 3; ++c) {
-        float s = bk_nb_w(BK_NB_B3 + c);
-        for (int i = 0; i < 21; ++i) s += h2[i] * bk_nb_w(BK_NB_W3 + 3 * i + c);
-        z[c] = min(s, 80.0);
-    }
-    // exp(z) - 1 without cancellation for small z (expm1)
-    vec3 e;
-    for (int c = 0; c < 3; ++c) {
-        float t = z[c];
-        e[c] = abs(t) < 1e-3 ? t * (1.0 + t * (0.5 + t / 6.0)) : exp(t) - 1.0;
-    }
-    return max(e, vec3(0.0));
+// the network at x = (xa.x, 0, xa.yzw, x5): RGB f_r in 1/sr
+vec3 bk_nbrdf_network(vec4 xa, float x5) {
+    vec4 a0 = BK_NB_L1(0), a1 = BK_NB_L1(1), a2 = BK_NB_L1(2), a3 = BK_NB_L1(3), a4 = BK_NB_L1(4), a5 = BK_NB_L1(5);
+    vec4 b0 = BK_NB_L2(0), b1 = BK_NB_L2(1), b2 = BK_NB_L2(2), b3 = BK_NB_L2(3), b4 = BK_NB_L2(4), b5 = BK_NB_L2(5);
+    vec4 z = u_nbrdf[210] + BK_NB_M4(186) * b0 + BK_NB_M4(190) * b1 + BK_NB_M4(194) * b2
+        + BK_NB_M4(198) * b3 + BK_NB_M4(202) * b4 + BK_NB_M4(206) * b5;
+    return max(bk_nb_expm1(min(z.xyz, vec3(80.0))), vec3(0.0));
 }
 
 vec3 brdf(vec3 wi, vec3 wo) {
     if (bk_below(wi, wo)) return vec3(0.0);
-    return bk_nbrdf_eval(bk_merl_angles(wi, wo));
+    vec4 q = bk_merl_half_diff(wi, wo);   // sin θh, cos θh, (d.x, d.y) in the half frame
+    vec2 l = bk_merl_lengths(wi, wo);     // 2 cos θd, 2 sin θd (unit vectors)
+    float n = length(l);                  // 2; |wi + wo|^2 + |wi − wo|^2 = 2 (|wi|^2 + |wo|^2)
+    // sin θd (cos φd, sin φd) = d.xy / 2, cos θd = |wi + wo| / 2
+    return bk_nbrdf_network(vec4(q.x, q.y, q.zw / n), l.x / n);
 }

@@ -17,6 +17,7 @@
   const status = {
     ready: false, webgl2: false, floatTargets: false, renderer: null,
     models: {}, error: null, frames: 0,
+    drawn: {},  // view -> how many times it was drawn (a setting redraws only the views it changes)
   };
   window.brdfkitStatus = status;
 
@@ -65,6 +66,7 @@
   };
   // IEC 61966-2-1 sRGB transfer functions (Python twin: brdfkit.render.image.srgb_encode).
   const srgbToLinear = (c) => (c <= 0.04045 ? c / 12.92 : Math.pow((c + 0.055) / 1.055, 2.4));
+  const srgbEncode = (c) => (c <= 0.0031308 ? 12.92 * c : 1.055 * Math.pow(c, 1 / 2.4) - 0.055);
   const linearToSrgb = (c) => (c <= 0.0031308 ? 12.92 * c : 1.055 * Math.pow(c, 1 / 2.4) - 0.055);
   const sph = (t, p) => [Math.sin(t) * Math.cos(p), Math.sin(t) * Math.sin(p), Math.cos(t)];
 
@@ -111,21 +113,23 @@ void main() {
 }
 `;
   const SRGB_GLSL = `
-float bkw_srgb1(float c) { return c <= 0.0031308 ? 12.92 * c : 1.055 * pow(c, 1.0 / 2.4) - 0.055; }
-vec3 bkw_srgb(vec3 c) { c = clamp(c, 0.0, 1.0); return vec3(bkw_srgb1(c.r), bkw_srgb1(c.g), bkw_srgb1(c.b)); }
+vec3 bkw_srgb(vec3 c) {  // one vector pow, not three scalar ones
+    c = clamp(c, 0.0, 1.0);
+    return mix(1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, 12.92 * c, lessThanEqual(c, vec3(0.0031308)));
+}
 `;
   const SPHERE_MAIN = `
 uniform vec4 bkw_viewport;     // x, y, w, h in pixels
 uniform vec3 bkw_light;        // unit, view space (viewer along +z)
 uniform float bkw_scale;       // light irradiance x 2^exposure
 uniform int bkw_tangent;       // 0: tangents along latitudes, 1: along longitudes
-uniform vec3 bkw_background;
+uniform vec3 bkw_background;  // sRGB-encoded (srgbEncode on the page)
 out vec4 bkw_color;
 ${SRGB_GLSL}
 void main() {
     vec2 p = ((gl_FragCoord.xy - bkw_viewport.xy) / bkw_viewport.zw * 2.0 - 1.0) * 1.06;
     float r2 = dot(p, p);
-    if (r2 >= 1.0) { bkw_color = vec4(bkw_srgb(bkw_background), 1.0); return; }
+    if (r2 >= 1.0) { bkw_color = vec4(bkw_background, 1.0); return; }
     vec3 n = vec3(p, sqrt(1.0 - r2));
     vec3 axis = bkw_tangent == 0 ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0);
     vec3 t = cross(axis, n);
@@ -140,7 +144,7 @@ void main() {
     vec3 c = brdf(wi, wo) * max(wi.z, 0.0) * bkw_scale;
     float r = sqrt(r2);
     float a = clamp((1.0 - r) / max(fwidth(r), 1e-6), 0.0, 1.0);
-    bkw_color = vec4(mix(bkw_srgb(bkw_background), bkw_srgb(c), a), 1.0);
+    bkw_color = vec4(mix(bkw_background, bkw_srgb(c), a), 1.0);
 }
 `;
   // θh × θd image at φd (Rusinkiewicz 1998, φh = 0): h = (sin θh, 0, cos θh); d in h's frame
@@ -191,7 +195,7 @@ void main() {
   let measuredNames = [];      // built-in measured materials
   const sources = {};          // source key -> GLSL text
   const programs = {};         // source key + "|" + kind -> WebGLProgram (or {error})
-  const nbrdfWeights = {};     // material -> Float32Array(676)
+  const nbrdfWeights = {};     // material -> Float32Array(844): u_nbrdf[211] of nbrdf.glsl
   const merlTables = {};       // loaded MERL file label -> {texture}
   const brdfFiles = {};        // loaded .brdf label -> {info, source key}
   let shaderFiles = {};        // pipeline_*.glsl etc.
@@ -253,9 +257,39 @@ void main() {
       reference: "", params: [] };
   }
 
-  // "eval" | "sphere" | "slice" | "obj-flat" | "obj-gouraud" | "obj-phong" | "gl-flat" ...
-  function getProgram(key, kind) {
-    const id = key + "|" + kind;
+  // The per-pixel views compile a model once per combination of its integer parameters
+  // (choices, booleans): their `uniform int u_x;` becomes `const int u_x = v;`, the rest of
+  // the model's GLSL unchanged, so the compiler drops the branches not taken. A software
+  // renderer (SwiftShader) otherwise runs every side of a branch on a uniform, tables of
+  // unused options included (microfacet's sphere at 750x750: 4.6 s -> 0.11 s a frame).
+  function intConstants(name, params) {
+    const k = kindOf(name);
+    if (k !== "analytic" && k !== "brdf") return null;
+    const info = infoOf(name);
+    const eff = effectiveParams(info, params);
+    const out = {};
+    for (const p of info.params) {
+      if (!p.uniform || p.uniform.type !== "int") continue;
+      const v = eff[p.name];
+      out[p.uniform.name] = p.kind === "choice" ? Math.max(0, p.choices.indexOf(v))
+        : p.kind === "bool" ? (v === true || v === 1 || v === "true" ? 1 : 0) : Math.round(+v);
+    }
+    return Object.keys(out).length ? out : null;
+  }
+  function sourceOf(key, consts) {
+    let src = sources[key];
+    if (src === undefined) throw new Error(`no GLSL source for '${key}'`);
+    for (const [n, v] of Object.entries(consts || {})) {
+      const re = new RegExp(`^uniform int ${n};`, "m");
+      src = src.replace(re, `const int ${n} = ${v};`);  // (a source without the line keeps its uniform)
+    }
+    return src;
+  }
+
+  // "eval" | "sphere" | "slice" | "obj-flat" | "obj-gouraud" | "obj-phong" | "gl-flat" ...;
+  // consts: intConstants(...) or null
+  function getProgram(key, kind, consts) {
+    const id = key + "|" + kind + (consts ? "|" + JSON.stringify(consts) : "");
     if (programs[id]) {
       if (programs[id].error) throw new Error(programs[id].error);
       return programs[id];
@@ -263,12 +297,11 @@ void main() {
     try {
       let prog;
       if (kind === "eval" || kind === "sphere" || kind === "slice") {
-        const src = sources[key];
-        if (src === undefined) throw new Error(`no GLSL source for '${key}'`);
+        const src = sourceOf(key, consts);
         const main = kind === "eval" ? EVAL_MAIN : kind === "sphere" ? SPHERE_MAIN : SLICE_MAIN;
         prog = compileProgram(VERT, src + main);
       } else {
-        prog = pipelineProgram(key, kind);
+        prog = pipelineProgram(key, kind, consts);
       }
       programs[id] = prog;
       return prog;
@@ -280,7 +313,7 @@ void main() {
 
   // The renderer's pipeline, assembled as brdfkit.render.renderer.Renderer._program does
   // (GLSL ES 3.00 instead of 3.30): kind = "obj-<shading>" (a BRDF) or "gl-<shading>" (fixed function).
-  function pipelineProgram(key, kind) {
+  function pipelineProgram(key, kind, consts) {
     const [what, shading] = kind.split("-");
     const F = shaderFiles;
     for (const f of ["pipeline_lights.glsl", "pipeline_vertex.glsl", "pipeline_fragment.glsl", "pipeline_brdf.glsl", "opengl_fixed.glsl"]) {
@@ -297,8 +330,7 @@ void main() {
     let body;
     if (what === "gl") body = F["pipeline_lights.glsl"] + F["opengl_fixed.glsl"];
     else {
-      const src = sources[key];
-      if (src === undefined) throw new Error(`no GLSL source for '${key}'`);
+      const src = sourceOf(key, consts);
       body = src.replace(/^#version[^\n]*\n/, "") + F["pipeline_lights.glsl"];
       if (what === "ibl") {
         if (F["ibl.glsl"] === undefined) throw new Error("this server has no image-based lighting shaders");
@@ -514,6 +546,78 @@ void main() {
     brdfFiles[label] = { info: Object.assign({ title: "Disney BRDF Explorer file", reference: "" }, body.info, { name: label }), key };
     refreshModelSelects();
     return label;
+  }
+
+  async function loadObjFile(file) {
+    const m = await fetchJSON("/api/mesh", { method: "POST", body: await file.arrayBuffer() });
+    m.name = file.name;
+    uploadedMesh = meshBuffers(m);
+    $("#obj-mesh option[value=uploaded]").disabled = false;
+    return "obj";
+  }
+
+  // Dropped files survive a reload: their bytes are kept in IndexedDB under their SHA-256,
+  // the state (URL, saved view) names them ({name, sha256}); a state naming a file this
+  // browser no longer holds is an error on the page.
+  const FILE_KINDS = [[/\.(binary|bin)$/i, loadMerlFile], [/\.brdf$/i, loadBrdfFile], [/\.obj$/i, loadObjFile]];
+  const loadedFiles = {};  // what a file made (file:NAME, brdf:NAME, or "obj") -> {name, sha256}
+  const fileLoader = (name) => (FILE_KINDS.find(([re]) => re.test(name)) || [null, null])[1];
+  let idbOpen = null;
+  function idbStore(mode) {
+    if (!idbOpen) {
+      idbOpen = new Promise((resolve, reject) => {
+        if (!window.indexedDB) { reject(new Error("this browser has no IndexedDB")); return; }
+        const r = indexedDB.open("brdfkit-files", 1);
+        r.onupgradeneeded = () => r.result.createObjectStore("files");
+        r.onsuccess = () => resolve(r.result);
+        r.onerror = () => reject(new Error("IndexedDB: " + (r.error ? r.error.message : "cannot open")));
+      });
+      idbOpen.catch(() => { idbOpen = null; });
+    }
+    return idbOpen.then((db) => db.transaction("files", mode).objectStore("files"));
+  }
+  const idbRequest = (req) => new Promise((resolve, reject) => {
+    req.onsuccess = () => resolve(req.result);
+    req.onerror = () => reject(new Error("IndexedDB: " + (req.error ? req.error.message : "failed")));
+  });
+  async function sha256Hex(bytes) {
+    if (!(window.crypto && crypto.subtle)) throw new Error("no crypto.subtle (the page is not a secure context: open it as 127.0.0.1 or localhost)");
+    const d = new Uint8Array(await crypto.subtle.digest("SHA-256", bytes));
+    return Array.from(d, (b) => b.toString(16).padStart(2, "0")).join("");
+  }
+  // load a dropped file's bytes into the page and keep them; -> the label of what it made
+  async function loadAndKeep(name, bytes) {
+    const label = await fileLoader(name)(new File([bytes], name));
+    try {
+      const sha256 = await sha256Hex(bytes);
+      await idbRequest((await idbStore("readwrite")).put({ name, bytes }, sha256));
+      loadedFiles[label] = { name, sha256 };
+    } catch (e) {
+      delete loadedFiles[label];
+      showError(`${name}: loaded, but not kept for a reload (${e.message})`);
+    }
+    return label;
+  }
+  // the files a state names, back from IndexedDB (a missing one: an error on the page)
+  async function restoreFiles(files, origin) {
+    if (!Array.isArray(files)) { showError(`${origin}: files must be a list of {"name", "sha256"}`); return; }
+    for (const f of files) {
+      const ok = f && typeof f.name === "string" && typeof f.sha256 === "string" && /^[0-9a-f]{64}$/.test(f.sha256);
+      if (!ok || !fileLoader(f.name)) { showError(`${origin}: bad files entry ${JSON.stringify(f)}`); continue; }
+      if (Object.values(loadedFiles).some((g) => g.sha256 === f.sha256 && g.name === f.name)) continue;
+      try {
+        const rec = await idbRequest((await idbStore("readonly")).get(f.sha256));
+        if (!rec) throw new Error("it is not stored in this browser (IndexedDB was cleared, or another browser or profile): drop the file again");
+        const label = await fileLoader(f.name)(new File([rec.bytes], f.name));
+        loadedFiles[label] = { name: f.name, sha256: f.sha256 };
+      } catch (e) { showError(`${origin}: dropped file '${f.name}' (sha256 ${f.sha256.slice(0, 12)}…): ${e.message}`); }
+    }
+  }
+  // the kept files the current state uses
+  function stateFiles(models) {
+    return Object.entries(loadedFiles)
+      .filter(([label]) => (label === "obj" ? getSetting("obj-mesh") === "uploaded" : models.includes(label)))
+      .map(([, f]) => ({ name: f.name, sha256: f.sha256 }));
   }
 
   // ------------------------------------------------------------------------
@@ -812,7 +916,7 @@ void main() {
     const first = list[0];
     const view = {};
     for (const id of Object.keys(SETTINGS)) view[id] = getSetting(id);
-    return {
+    const st = {
       model: first ? first.model : null,
       params: first ? first.params() : {},
       visible: first ? first.visible : true,
@@ -821,6 +925,9 @@ void main() {
       view,
       orbit: JSON.parse(JSON.stringify(orbit)),
     };
+    const files = stateFiles(list.map((p) => p.model));
+    if (files.length) st.files = files;
+    return st;
   }
 
   function stateToURL(st) {
@@ -829,6 +936,7 @@ void main() {
     q.set("p", JSON.stringify(st.params));
     if (st.visible === false) q.set("hide", "1");
     if (st.compare.length) q.set("compare", JSON.stringify(st.compare));
+    if (st.files) q.set("files", JSON.stringify(st.files));
     const view = {};
     for (const [k, v] of Object.entries(st.view)) if (v !== DEFAULTS[k]) view[k] = v;
     view.panes = st.panes;
@@ -844,10 +952,11 @@ void main() {
   // URL query -> a state object (throws with a one-line message naming the bad part)
   function urlToState(search) {
     const q = new URLSearchParams(search);
-    const allowed = new Set(["model", "p", "compare", "view", "hide"]);
-    for (const k of q.keys()) if (!allowed.has(k)) throw new Error(`URL: unknown parameter '${k}'; allowed: model, p, compare, view`);
+    const allowed = new Set(["model", "p", "compare", "view", "hide", "files"]);
+    for (const k of q.keys()) if (!allowed.has(k)) throw new Error(`URL: unknown parameter '${k}'; allowed: model, p, compare, view, files`);
     const st = { model: q.get("model"), params: {}, compare: [], view: {}, visible: q.get("hide") !== "1" };
     if (q.has("p")) st.params = parseJSONParam(q.get("p"), "URL p");
+    if (q.has("files")) st.files = parseJSONParam(q.get("files"), "URL files");
     const c = q.get("compare");
     if (c) {
       if (c.trim().startsWith("[")) st.compare = parseJSONParam(c, "URL compare");
@@ -881,6 +990,7 @@ void main() {
   // apply a state object; every bad part is reported on the page, the rest still applied
   async function applyState(st, origin) {
     if (st === null || typeof st !== "object" || Array.isArray(st)) throw new Error(`${origin}: expected a JSON object`);
+    if (st.files !== undefined) await restoreFiles(st.files, origin);  // before the panels that use them
     const entries = [];
     if (st.model !== undefined && st.model !== null) entries.push({ model: st.model, params: st.params || {}, visible: st.visible !== false });
     if (st.compare !== undefined) {
@@ -1029,13 +1139,18 @@ void main() {
   // ------------------------------------------------------------------------
   // drawing helpers
   // ------------------------------------------------------------------------
-  let drawPending = false;
-  function scheduleDraw() {
+  // the next frame draws every pane, or (drawOnly, a Set) only the views asked for
+  let drawPending = false, drawOnly = null;
+  function scheduleDraw(only) {
+    if (!drawPending) drawOnly = only ? new Set([only]) : null;
+    else if (drawOnly) { if (only) drawOnly.add(only); else drawOnly = null; }
     if (drawPending) return;
     drawPending = true;
-    requestAnimationFrame(() => { drawPending = false; draw(); });
+    requestAnimationFrame(() => { const o = drawOnly; drawPending = false; drawOnly = null; draw(false, o); });
   }
-  function changed() { updateOutputs(); updateURL(); scheduleDraw(); }
+  // a change of state; only: the one view it affects (the light of the lit sphere), else all
+  function changed(only) { updateOutputs(); updateURL(); scheduleDraw(typeof only === "string" ? only : null); }
+  const SPHERE_ONLY = new Set(["light-theta", "light-phi", "tangent"]);  // settings only the lit sphere reads
 
   function channelOf(f, k, ch) {
     const r = f[3 * k], g = f[3 * k + 1], b = f[3 * k + 2];
@@ -1398,14 +1513,18 @@ void main() {
     viewData.lobe3d = csvFrom(["theta_o_deg", "phi_o_deg"], [th, ph], evals, n);
   }
 
-  // a row of tiles, one per visible BRDF, in a canvas of the view's size
-  function tiles(canvas, count, aspect) {
-    const W = canvas.width, H = canvas.height;
+  // a row of square tiles, one per visible BRDF, each with a label line under it (LABEL_H),
+  // in a canvas of the view's width; the canvas's height follows the row (at most its height
+  // in index.html), so that no empty band is left below the tiles
+  const LABEL_H = 18;
+  function fitTiles(canvas, count) {
+    if (!canvas.dataset.maxHeight) canvas.dataset.maxHeight = String(canvas.height);
+    const W = canvas.width, H = +canvas.dataset.maxHeight;
     const n = Math.max(1, count);
-    let w = Math.floor(W / n), h = Math.floor(w / aspect);
-    if (h > H - 18) { h = H - 18; w = Math.floor(h * aspect); }
+    const w = Math.max(1, Math.min(Math.floor(W / n), H - LABEL_H));
+    if (canvas.height !== w + LABEL_H) canvas.height = w + LABEL_H;
     const x0 = Math.floor((W - n * w) / 2);
-    return Array.from({ length: n }, (_, i) => ({ x: x0 + i * w, y: 0, w, h }));
+    return Array.from({ length: n }, (_, i) => ({ x: x0 + i * w, y: 0, w, h: w }));
   }
 
   function lightDir() {
@@ -1417,8 +1536,9 @@ void main() {
     const canvas = canvasArg || canvasOf("sphere");
     const ctx = canvas.getContext("2d");
     const list = visiblePanels();
-    ctx.fillStyle = "#222"; ctx.fillRect(0, 0, canvas.width, canvas.height);
-    const T = tiles(canvas, list.length, 1);
+    const T = fitTiles(canvas, list.length);
+    const bgByte = Math.round(255 * srgbEncode(BACKGROUND));  // the spheres' own background, no band around them
+    ctx.fillStyle = `rgb(${bgByte}, ${bgByte}, ${bgByte})`; ctx.fillRect(0, 0, canvas.width, canvas.height);
     const size = T[0].w;
     glSize(size * list.length, size);
     gl.bindFramebuffer(gl.FRAMEBUFFER, null);
@@ -1427,14 +1547,15 @@ void main() {
     const scale = Math.PI * Math.pow(2, num("exposure"));
     list.forEach((panel, i) => {
       try {
-        const prog = getProgram(sourceKey(panel.model), "sphere");
+        const prog = getProgram(sourceKey(panel.model), "sphere", intConstants(panel.model, panel.params()));
         gl.useProgram(prog);
         gl.viewport(i * size, 0, size, size);
         gl.uniform4f(U(prog, "bkw_viewport"), i * size, 0, size, size);
         gl.uniform3f(U(prog, "bkw_light"), L[0], L[1], L[2]);
         gl.uniform1f(U(prog, "bkw_scale"), scale);
         gl.uniform1i(U(prog, "bkw_tangent"), parseInt(getSetting("tangent"), 10));
-        gl.uniform3f(U(prog, "bkw_background"), BACKGROUND, BACKGROUND, BACKGROUND);
+        const bg = srgbEncode(BACKGROUND);
+        gl.uniform3f(U(prog, "bkw_background"), bg, bg, bg);
         bindMaterial(prog, panel.model, panel.params());
         gl.drawArrays(gl.TRIANGLES, 0, 3);
       } catch (e) { reportDrawError(e); }
@@ -1451,8 +1572,8 @@ void main() {
     const canvas = canvasOf("slice");
     const ctx = canvas.getContext("2d");
     const list = visiblePanels();
+    const T = fitTiles(canvas, list.length);
     ctx.fillStyle = "#222"; ctx.fillRect(0, 0, canvas.width, canvas.height);
-    const T = tiles(canvas, list.length, 1);
     const size = T[0].w;
     glSize(size * list.length, size);
     gl.bindFramebuffer(gl.FRAMEBUFFER, null);
@@ -1472,7 +1593,7 @@ void main() {
           let m = 0; for (const x of f) m = Math.max(m, x);
           scale = m > 0 ? m * Math.pow(2, num("exposure")) : 1;
         }
-        const prog = getProgram(sourceKey(panel.model), "slice");
+        const prog = getProgram(sourceKey(panel.model), "slice", intConstants(panel.model, panel.params()));
         gl.bindFramebuffer(gl.FRAMEBUFFER, null);
         gl.useProgram(prog);
         gl.viewport(i * size, 0, size, size);
@@ -1578,7 +1699,7 @@ void main() {
       const i = parseInt(matSel.slice(5), 10);
       panel = visiblePanels()[i];
       if (!panel) return `no visible BRDF number ${i + 1}`;
-      prog = getProgram(sourceKey(panel.model), "obj-" + shading);
+      prog = getProgram(sourceKey(panel.model), "obj-" + shading, intConstants(panel.model, panel.params()));
       label = panel.model;
     }
     const ambientAlbedo = panel ? normalAlbedo(panel) : null; // (runs the eval program: before useProgram)
@@ -1700,7 +1821,7 @@ void main() {
       }
     }
     if (ibl.spp < iblMax()) {
-      const prog = getProgram(sourceKey(panel.model), "ibl-phong");
+      const prog = getProgram(sourceKey(panel.model), "ibl-phong", intConstants(panel.model, panel.params()));
       gl.bindFramebuffer(gl.FRAMEBUFFER, ibl.fbo);
       gl.viewport(0, 0, w, h);
       gl.clearColor(0, 0, 0, 0); gl.clearDepth(1);
@@ -1799,13 +1920,19 @@ void main() {
     lobe3d: drawLobe3D, polar: drawPolar, theta_h: () => drawHalfDiffPlot("theta_h"), theta_d: () => drawHalfDiffPlot("theta_d"),
     theta_v: drawThetaV, albedo: drawAlbedo, sphere: () => drawSphere(), slice: drawSlice, object: () => drawObject(),
   };
-  function drawView(name) { if (gl) DRAW[name](); }
+  function drawView(name) {
+    if (!gl) return;
+    DRAW[name]();
+    status.drawn[name] = (status.drawn[name] || 0) + 1;
+  }
 
-  function draw(onlyObject) {
+  // onlyObject: the progressive environment-lit object's next pass; views: a Set, or null for all
+  function draw(onlyObject, views) {
     if (!gl) return;
     updateOutputs();
-    ibl.pending = false;
-    for (const v of panes) if (!onlyObject || v === "object") drawView(v);
+    const list = panes.filter((v) => (views ? views.has(v) : (!onlyObject || v === "object")));
+    if (list.includes("object")) ibl.pending = false;  // (else a progressive object keeps its next pass)
+    for (const v of list) drawView(v);
     status.frames += 1;
     if (ibl.pending && panes.includes("object")) {  // progressive: another pass of the lit object next frame
       requestAnimationFrame(() => { if (!drawPending) draw(true); });
@@ -1830,7 +1957,7 @@ void main() {
         const nz = Math.sqrt(1 - r2);
         setSetting("light-theta", Math.round(Math.acos(nz) / DEG * 2) / 2);
         setSetting("light-phi", Math.round(((Math.atan2(py, px) / DEG + 360) % 360) * 2) / 2);
-        changed();
+        changed("sphere");
         return;
       }
     };
@@ -1869,22 +1996,12 @@ void main() {
         let st;
         try { st = JSON.parse(await file.text()); } catch (e) { throw new Error(`${file.name}: not valid JSON (${e.message})`); }
         await applyState(st, file.name);
-      } else if (name.endsWith(".binary") || name.endsWith(".bin")) {
-        const label = await loadMerlFile(file);
-        addPanel(label, {});
-        changed();
-      } else if (name.endsWith(".brdf")) {
-        const label = await loadBrdfFile(file);
-        addPanel(label, {});
-        changed();
-      } else if (name.endsWith(".obj")) {
-        const m = await fetchJSON("/api/mesh", { method: "POST", body: await file.arrayBuffer() });
-        m.name = file.name;
-        uploadedMesh = meshBuffers(m);
-        const opt = $("#obj-mesh option[value=uploaded]");
-        opt.disabled = false;
-        setSetting("obj-mesh", "uploaded");
-        if (!panes.includes("object")) showView("object", 1);
+      } else if (fileLoader(name)) {
+        const label = await loadAndKeep(file.name, await file.arrayBuffer());
+        if (label === "obj") {
+          setSetting("obj-mesh", "uploaded");
+          if (!panes.includes("object")) showView("object", 1);
+        } else addPanel(label, {});
         changed();
       } else {
         throw new Error(`${file.name}: unknown file type; drop a .json view, a MERL .binary, a .brdf or an .obj`);
@@ -1960,8 +2077,9 @@ void main() {
     refreshObjectMaterials();
     for (const id of Object.keys(SETTINGS)) {
       DEFAULTS[id] = getSetting(id);
-      $("#" + id).addEventListener("input", changed);
-      $("#" + id).addEventListener("change", changed);
+      const only = SPHERE_ONLY.has(id) ? "sphere" : null;
+      $("#" + id).addEventListener("input", () => changed(only));
+      $("#" + id).addEventListener("change", () => changed(only));
     }
     $("#add-brdf").addEventListener("click", () => {
       const taken = new Set(panels.map((p) => p.model));
