@@ -3,17 +3,22 @@
     python benchmarks/bench_fit.py                 # one material × five models, and one table-scale fit
     python benchmarks/bench_fit.py --scaling       # a 10 × 5 batch on 1 and on 2 local workers
     python benchmarks/bench_fit.py --batch         # the whole MERL batch (100 × 5) on 2 local workers
+    python benchmarks/bench_fit.py --batch --save new.json --compare old.json   # and its losses vs another run's
     python benchmarks/bench_fit.py --starts-needed # how many starts reach the dense multi-start minimum
 
 Prints wall times (default settings of ``brdfkit fit``: 3000 samples, 4 starts, metric
-ngan), errors and evaluations used; nothing is asserted. Targets (issue 10): the 100 × 5
+ngan), errors and evaluations used, and for a batch the CPU seconds its worker processes
+used (on a shared machine, CPU / workers bounds what an idle one would take); nothing is
+asserted. Targets (issue 10): the 100 × 5
 batch under 60 s on two cores, one table-scale fit under 5 s.
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import os
+import resource
 import shutil
 import tempfile
 import time
@@ -32,16 +37,39 @@ MODELS = (
 )
 
 
+def _cpu() -> float:
+    """CPU seconds of this process and its finished children."""
+    me, kids = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
+    return me.ru_utime + me.ru_stime + kids.ru_utime + kids.ru_stime
+
+
 def _batch(sources, workers, samples=3000):
+    """``(wall s, CPU s of this process and the workers, outcome)`` of a batch of :data:`MODELS`."""
     from brdfkit.measured.batch import run_batch
 
     out = tempfile.mkdtemp(prefix="brdfkit-bench-")
     try:
-        w0 = time.perf_counter()
+        w0, c0 = time.perf_counter(), _cpu()
         res = run_batch([n for n, _ in MODELS], sources, out, fixed=dict(MODELS), workers=workers, samples=samples)
-        return time.perf_counter() - w0, res
+        return time.perf_counter() - w0, _cpu() - c0, res
     finally:
         shutil.rmtree(out, ignore_errors=True)
+
+
+def _losses(res) -> dict[str, float]:
+    return {f"{r['source']}|{r['column']}": r["error"] for r in res.records if r}
+
+
+def compare_losses(new: dict[str, float], old: dict[str, float]) -> str:
+    """Median and max relative change of the losses of the fits both runs have."""
+    keys = sorted(set(new) & set(old))
+    if not keys:
+        return "no fits in common"
+    rel = np.array([(new[k] - old[k]) / old[k] for k in keys])
+    worst = keys[int(np.argmax(rel))]
+    return (f"{len(keys)} fits in common: relative change of the loss median {np.median(rel):+.2e}, "
+            f"max {rel.max():+.2e} ({worst}), min {rel.min():+.2e}; worse by more than 1e-6 on "
+            f"{int((rel > 1e-6).sum())}, by more than 1e-3 on {int((rel > 1e-3).sum())}")
 
 
 def main() -> int:
@@ -51,64 +79,86 @@ def main() -> int:
     ap.add_argument("--scaling", action="store_true", help="a 10 × 5 batch with 1 and with 2 workers")
     ap.add_argument("--starts-needed", action="store_true", help="starts needed to reach a dense search's minimum")
     ap.add_argument("--n-materials", type=int, default=8, help="materials for --starts-needed")
+    ap.add_argument("--save", help="with --batch: write its losses to this JSON file")
+    ap.add_argument("--compare", help="with --batch: compare its losses with those saved in this JSON file")
+    ap.add_argument("--skip-single", action="store_true", help="skip the single and table-scale fits")
     args = ap.parse_args()
 
     print(f"cpus available: {len(os.sched_getaffinity(0))}, load average: {os.getloadavg()[0]:.2f}, "
           f"engine: {bk.engine() if hasattr(bk, 'engine') else 'numpy (reference)'}")
-    t0 = time.perf_counter()
-    data = F.sample(args.material, n=3000)
-    print(f"sampling {args.material}: {time.perf_counter() - t0:.2f} s")
-    print(f"{'model':<20}{'free values':>12}{'wall s':>9}{'cpu s':>9}{'evals':>8}{'error':>12}")
-    for name, fixed in MODELS:
-        w0, c0 = time.perf_counter(), time.process_time()
-        r = F.fit(name, args.material, fixed=fixed, data=data)
-        wall, cpu = time.perf_counter() - w0, time.process_time() - c0
-        print(f"{name:<20}{r.n_free:>12}{wall:>9.2f}{cpu:>9.2f}{r.nfev:>8}{r.error:>12.5g}")
-
-    w0 = time.perf_counter()
-    tab = F.table(args.material)
-    t_tab = time.perf_counter() - w0
-    print(f"table of {args.material}: {len(tab)} bins within 80° (tabulated in {t_tab:.2f} s)")
-    for name, fixed in (MODELS[4], MODELS[0]):
-        w0 = time.perf_counter()
-        r = F.fit(name, args.material, fixed=fixed, data=tab, samples="table")
-        print(f"table-scale fit, {name} ← {args.material}: {time.perf_counter() - w0:.2f} s, "
-              f"error {r.error:.5g}, {r.nfev} evaluations")
-
+    if not args.skip_single:
+        single(args.material)
     if args.scaling:
         from brdfkit.measured.commands import measured_names
 
         sources = measured_names("merl")[:10]
-        t1, _ = _batch(sources, 1)
-        t2, _ = _batch(sources, 2)
-        print(f"10 × 5 batch: 1 worker {t1:.1f} s, 2 workers {t2:.1f} s, speed-up {t1 / t2:.2f}x")
+        t1, c1, _ = _batch(sources, 1)
+        t2, c2, _ = _batch(sources, 2)
+        print(f"10 × 5 batch: 1 worker {t1:.1f} s (CPU {c1:.1f} s), 2 workers {t2:.1f} s (CPU {c2:.1f} s), "
+              f"speed-up {t1 / t2:.2f}x; load average now {os.getloadavg()[0]:.2f}")
     if args.batch:
         from brdfkit.measured.commands import measured_names
 
         sources = measured_names("merl")
-        wall, res = _batch(sources, 2)
+        wall, cpu, res = _batch(sources, 2)
         n = len(sources) * len(MODELS)
         print(f"MERL batch: {len(sources)} materials × {len(MODELS)} models on 2 workers in {wall:.0f} s "
-              f"({wall / n:.2f} s per fit); {len(res.at_bound)} fits on a bound")
-    if args.starts_needed:
-        from brdfkit.measured.commands import measured_names
+              f"({wall / n:.2f} s per fit; CPU {cpu:.0f} s, {cpu / n:.2f} s per fit); {len(res.at_bound)} fits on a bound; "
+              f"load average now {os.getloadavg()[0]:.2f}")
+        if args.save:
+            from brdfkit.fileio import write_json
 
-        names = measured_names("merl")
-        pick = [names[i] for i in np.linspace(0, len(names) - 1, args.n_materials).astype(int)]
-        cases = list(MODELS) + [("lafortune", {}), ("ward", {"normalization": "dur"})]
-        print(f"starts needed to come within 1 % of a 32-start search from 400 candidates "
-              f"({len(pick)} materials, 800 samples):")
-        for name, fixed in cases:
-            need = []
-            for src in pick:
-                d = F.sample(src, n=800, seed=5)
-                r = F.fit(name, src, fixed=fixed, data=d, seed=5, starts=8)
-                dense = F.fit(name, src, fixed=fixed, data=d, seed=105, starts=32, candidates=400)
-                best = np.minimum.accumulate(r.start_errors)
-                ok = np.flatnonzero(best <= 1.01 * dense.error)
-                need.append(int(ok[0]) + 1 if ok.size else 99)
-            print(f"  {name:<18}{str(fixed):<48} starts needed: max {max(need)}, per material {need}", flush=True)
+            write_json(args.save, _losses(res), indent=1)
+        if args.compare:
+            with open(args.compare) as fh:
+                print("losses against", args.compare + ":", compare_losses(_losses(res), json.load(fh)))
+    if args.starts_needed:
+        starts_needed(args.n_materials)
     return 0
+
+
+def single(material: str) -> None:
+    """One material × the five models, and two table-scale fits."""
+    t0 = time.perf_counter()
+    data = F.sample(material, n=3000)
+    print(f"sampling {material}: {time.perf_counter() - t0:.2f} s")
+    print(f"{'model':<20}{'free values':>12}{'wall s':>9}{'cpu s':>9}{'evals':>8}{'error':>12}")
+    for name, fixed in MODELS:
+        w0, c0 = time.perf_counter(), time.process_time()
+        r = F.fit(name, material, fixed=fixed, data=data)
+        wall, cpu = time.perf_counter() - w0, time.process_time() - c0
+        print(f"{name:<20}{r.n_free:>12}{wall:>9.2f}{cpu:>9.2f}{r.nfev:>8}{r.error:>12.5g}")
+
+    w0 = time.perf_counter()
+    tab = F.table(material)
+    t_tab = time.perf_counter() - w0
+    print(f"table of {material}: {len(tab)} bins within 80° (tabulated in {t_tab:.2f} s)")
+    for name, fixed in (MODELS[4], MODELS[0]):
+        w0 = time.perf_counter()
+        r = F.fit(name, material, fixed=fixed, data=tab, samples="table")
+        print(f"table-scale fit, {name} ← {material}: {time.perf_counter() - w0:.2f} s, "
+              f"error {r.error:.5g}, {r.nfev} evaluations")
+
+
+def starts_needed(n_materials: int) -> None:
+    """How many starts reach a dense multi-start search's minimum."""
+    from brdfkit.measured.commands import measured_names
+
+    names = measured_names("merl")
+    pick = [names[i] for i in np.linspace(0, len(names) - 1, n_materials).astype(int)]
+    cases = list(MODELS) + [("lafortune", {}), ("ward", {"normalization": "dur"})]
+    print(f"starts needed to come within 1 % of a 32-start search from 400 candidates "
+          f"({len(pick)} materials, 800 samples):")
+    for name, fixed in cases:
+        need = []
+        for src in pick:
+            d = F.sample(src, n=800, seed=5)
+            r = F.fit(name, src, fixed=fixed, data=d, seed=5, starts=8)
+            dense = F.fit(name, src, fixed=fixed, data=d, seed=105, starts=32, candidates=400)
+            best = np.minimum.accumulate(r.start_errors)
+            ok = np.flatnonzero(best <= 1.01 * dense.error)
+            need.append(int(ok[0]) + 1 if ok.size else 99)
+        print(f"  {name:<18}{str(fixed):<48} starts needed: max {max(need)}, per material {need}", flush=True)
 
 
 if __name__ == "__main__":

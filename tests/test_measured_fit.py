@@ -203,3 +203,55 @@ def test_cli_list_measured(_cli):
     assert r.returncode == 0, r.stderr
     names = json.loads(r.stdout)
     assert len(names) == 159 and "merl/chrome" in names and "nielsen/bluebook" in names
+
+
+# --------------------------------------------------------------------------- speed-ups (issue 10)
+def _probe(name, fixed, n=600):
+    data = F.sample("merl/gold-metallic-paint", n=n, seed=3)
+    packer = F.ParamPacker(registry.get(name), fixed)
+    res = F._residual_fn(packer, data, F._transform("ngan"), "ngan")
+    rng = np.random.default_rng(4)
+    F._freeze_unused(packer, res, rng)
+    pts = [packer.x_of(packer.fixed), packer.random_x(rng, 1)[0]]
+    return packer, res, pts, rng
+
+
+@pytest.mark.parametrize("name, fixed", [("cook-torrance", {}), ("blinn-phong", {}),
+                                         ("microfacet", {"distribution": "ggx", "fresnel": "schlick"})])
+def test_constant_columns_are_the_lambertian_kd_only(name, fixed):
+    packer, res, pts, _ = _probe(name, fixed)
+    const = F.constant_columns(res, packer, pts)
+    labels = sorted(f"{packer.slots[i].param.name}[{packer.slots[i].channel}]" for i in const)
+    assert labels == ["kd[0]", "kd[1]", "kd[2]"]
+
+
+def test_constant_columns_none_for_a_coupled_diffuse_term():
+    # the paper form of Ashikhmin-Shirley: the diffuse term is rd·(1 − rs)·…, so ∂f/∂rd depends on rs
+    packer, res, pts, _ = _probe("ashikhmin-shirley", {})
+    assert F.constant_columns(res, packer, pts) == {}
+
+
+def test_jacobian_with_constant_columns_equals_forward_differences():
+    from scipy.optimize._numdiff import approx_derivative
+
+    packer, res, pts, rng = _probe("cook-torrance", {})
+    const = F.constant_columns(res, packer, pts)
+    assert const
+    x = packer.random_x(rng, 1)[0]
+    J = F._jacobian(F._Start(res, packer, []), packer, const)(x)
+    ref = approx_derivative(res, x, method="2-point", bounds=(packer.lb, packer.ub))
+    scale = np.abs(ref).max(axis=0)
+    assert np.all(np.abs(J - ref).max(axis=0) <= 1e-4 * scale + 1e-12)
+
+
+def test_starts_joining_a_known_basin_stop_early_and_lose_nothing(monkeypatch):
+    data = F.sample("merl/gold-metallic-paint", n=800, seed=2)
+    kw = dict(fixed={"distribution": "ggx", "fresnel": "schlick"}, data=data, seed=2)
+    joined = F.fit("microfacet", "merl/gold-metallic-paint", **kw)
+    monkeypatch.setattr(F, "JOIN_XTOL", 0.0)  # no start can join: each runs to convergence
+    full = F.fit("microfacet", "merl/gold-metallic-paint", **kw)
+    assert joined.nfev < full.nfev
+    assert joined.error <= full.error * (1 + 1e-6)
+    # a joined start stopped within JOIN_RTOL (in cost) of the best minimum
+    best = min(joined.start_errors)
+    assert sum(e <= best * (1 + F.JOIN_RTOL) ** 0.5 for e in joined.start_errors) >= 2

@@ -226,6 +226,9 @@ def _ignore_sigint() -> None:
     signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
+_ONE_THREAD = {"OMP_NUM_THREADS": "1", "NUMBA_NUM_THREADS": "1"}
+
+
 def _run_local(todo: list[Job], workers: int | None, finished) -> None:
     import concurrent.futures as cf
     import multiprocessing as mp
@@ -237,25 +240,31 @@ def _run_local(todo: list[Job], workers: int | None, finished) -> None:
         for j in todo:
             finished(j, fit_task(j))
         return
-    env_before = os.environ.get("OMP_NUM_THREADS")
-    os.environ["OMP_NUM_THREADS"] = "1"  # one BLAS thread per worker process (inherited at spawn)
-    try:
-        ex = cf.ProcessPoolExecutor(max_workers=min(n, len(todo)), mp_context=mp.get_context("spawn"),
-                                    initializer=_ignore_sigint)
-    finally:
-        if env_before is None:
-            os.environ.pop("OMP_NUM_THREADS", None)
-        else:
-            os.environ["OMP_NUM_THREADS"] = env_before
+    # one BLAS and one numba thread per worker process: the pool already runs one fit per core.
+    # The pool spawns its processes as tasks are submitted, so the environment they inherit is
+    # set until every task is.
+    env_before = {k: os.environ.get(k) for k in _ONE_THREAD}
     futs = {}
+    ex = None
     try:
-        futs = {ex.submit(fit_task, j): j for j in todo}
+        os.environ.update(_ONE_THREAD)
+        try:
+            ex = cf.ProcessPoolExecutor(max_workers=min(n, len(todo)), mp_context=mp.get_context("spawn"),
+                                        initializer=_ignore_sigint)
+            futs = {ex.submit(fit_task, j): j for j in todo}
+        finally:
+            for k, v in env_before.items():
+                if v is None:
+                    os.environ.pop(k, None)
+                else:
+                    os.environ[k] = v
         for f in cf.as_completed(futs):
             finished(futs[f], f.result())
     finally:
         for f in futs:
             f.cancel()
-        ex.shutdown(wait=True, cancel_futures=True)
+        if ex is not None:
+            ex.shutdown(wait=True, cancel_futures=True)
 
 
 def _run_dask(todo: list[Job], scheduler: str, finished) -> None:

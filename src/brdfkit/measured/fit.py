@@ -37,7 +37,12 @@ metric      T(f)                       source
 Optimiser: ``scipy.optimize.least_squares`` (trust-region reflective, bounds)
 from several starts: the parameters' defaults plus the best of a few dozen
 random points of the bounded parameter space (multi-start, so a local minimum
-does not decide); the best result wins.
+does not decide); the best result wins. A start that enters the basin of a
+minimum an earlier start converged to (within :data:`JOIN_XTOL` of it in every
+free value, :data:`JOIN_RTOL` in cost) stops there; its ``start_errors`` entry is
+the error it had then. The Jacobian is by forward differences, except for the
+columns of parameters the residuals are affine in with a constant coefficient
+(a Lambertian ``kd``), found by probing (:func:`constant_columns`) and reused.
 """
 
 from __future__ import annotations
@@ -45,6 +50,7 @@ from __future__ import annotations
 import math
 import os
 import time
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from typing import Any, Callable, Iterable, Mapping
 
@@ -518,11 +524,24 @@ def _freeze_unused(packer: ParamPacker, residuals, rng: np.random.Generator) -> 
 TABLE_SEARCH_SAMPLES = 3000
 
 
-def _residual_fn(packer: "ParamPacker", data: Samples, T):
+def _residual_fn(packer: "ParamPacker", data: Samples, T, metric: str = ""):
+    """``x ↦`` the weighted, normalised residual vector of ``data`` (its squared norm is the metric²).
+
+    For the metrics linear in f (``ngan``: f cos θi, ``l2``: f) the weights, cosines and target
+    are folded into two arrays once, so a call is one model evaluation and one fused update."""
     c = data.cos_i[:, None]
     target = T(data.f, c)
     sw = np.sqrt(data.w)[:, None]
     scale = 1.0 / math.sqrt(target.size)
+    if metric in ("ngan", "l2"):
+        gain = np.ascontiguousarray(np.broadcast_to(sw * scale * (c if metric == "ngan" else 1.0), target.shape))
+        offset = gain * data.f
+
+        def residuals(x: np.ndarray) -> np.ndarray:
+            r = np.multiply(packer.model(x).eval(data.wi, data.wo), gain)
+            return np.subtract(r, offset, out=r).ravel()
+
+        return residuals
 
     def residuals(x: np.ndarray) -> np.ndarray:
         f = np.asarray(packer.model(x).eval(data.wi, data.wo), np.float64)
@@ -531,7 +550,118 @@ def _residual_fn(packer: "ParamPacker", data: Samples, T):
     return residuals
 
 
-def _local(residuals, x0, packer, max_nfev, tol):
+def _value_derivative(residuals, packer: "ParamPacker", x: np.ndarray, i: int, r0: np.ndarray) -> np.ndarray:
+    """∂r/∂v of slot ``i``'s parameter value v (not its optimiser coordinate) at ``x``, by a forward
+    difference of 10⁻³ of its range (exact for a parameter the residuals are affine in)."""
+    s = packer.slots[i]
+    v = s.from_x(float(x[i]))
+    hv = 1e-3 * (s.hi - s.lo)
+    if v + hv > s.hi:
+        hv = -hv
+    y = x.copy()
+    y[i] = s.to_x(v + hv)
+    return (residuals(y) - r0) / hv
+
+
+def constant_columns(residuals, packer: "ParamPacker", points: Iterable[np.ndarray]) -> dict[int, np.ndarray]:
+    """The slots whose residuals' derivative with respect to the parameter's value is the same at
+    every one of ``points``: parameters the model is affine in with a coefficient no other
+    parameter changes (a Lambertian ``kd``: ∂f/∂kd = 1/π). Their Jacobian column is known once
+    for all (:func:`_jacobian`). Returns ``{slot: ∂r/∂v}``; costs one evaluation per point and
+    one per slot and point."""
+    pts = [np.asarray(x, dtype=np.float64) for x in points]
+    base = [residuals(x) for x in pts]
+    out = {}
+    for i in range(len(packer)):
+        ref = None
+        for x, r0 in zip(pts, base):
+            d = _value_derivative(residuals, packer, x, i, r0)
+            if ref is None:
+                ref = d
+                if not np.any(ref):
+                    break  # no effect here: not known to be constant
+            elif not np.allclose(d, ref, rtol=1e-6, atol=1e-9 * float(np.max(np.abs(ref)))):
+                ref = None
+                break
+        if ref is not None and np.any(ref):
+            out[i] = ref
+    return out
+
+
+def _jacobian(fn: "_Start", packer: "ParamPacker", const: Mapping[int, np.ndarray]):
+    """The residuals' Jacobian in the optimiser's coordinates: forward differences (the step of
+    ``scipy.optimize.approx_derivative``'s 2-point scheme, away from a bound) except for the
+    :func:`constant_columns`, which are their fixed ∂r/∂v times dv/dx (v for a log-scale slot)."""
+    rel = getattr(packer.cls, "fit_diff_step", None) or float(np.finfo(np.float64).eps) ** 0.5
+
+    def jac(x: np.ndarray) -> np.ndarray:
+        r0 = fn.at(x)
+        J = np.empty((r0.size, len(x)))
+        for i, s in enumerate(packer.slots):
+            if i in const:
+                J[:, i] = const[i] * (s.from_x(float(x[i])) if s.log else 1.0)
+                continue
+            h = rel * max(1.0, abs(float(x[i]))) * (1.0 if x[i] >= 0 else -1.0)
+            if not packer.lb[i] <= x[i] + h <= packer.ub[i]:
+                h = -h
+            y = x.copy()
+            y[i] += h
+            h = y[i] - x[i]  # the step as represented
+            J[:, i] = (fn(y) - r0) / h
+        return J
+
+    return jac
+
+
+#: a start that reaches a point within this fraction of every free value's (optimiser-space) range
+#: of a minimum an earlier start converged to, with a cost within :data:`JOIN_RTOL` of that
+#: minimum's, is in the same basin: it stops there instead of converging again (the basin-joining
+#: rule of clustering multi-start methods, Rinnooy Kan & Timmer, Math. Programming 39, 1987)
+JOIN_XTOL = 1e-2
+JOIN_RTOL = 1e-3
+
+
+class _Joined(Exception):
+    """Raised inside a start's residuals when it has entered a known minimum's basin."""
+
+    def __init__(self, x: np.ndarray, cost: float) -> None:
+        super().__init__()
+        self.x, self.cost = x, cost
+
+
+class _Start:
+    """One local optimisation's residuals: counts evaluations, remembers the last one (the
+    Jacobian is taken where the residuals were just evaluated) and stops in a known basin."""
+
+    def __init__(self, residuals, packer: "ParamPacker", known: list[tuple[np.ndarray, float]]) -> None:
+        self.residuals, self.known, self.nfev = residuals, known, 0
+        self.span = np.maximum(packer.ub - packer.lb, 1e-300)
+        self._last: tuple[np.ndarray, np.ndarray] | None = None
+
+    def __call__(self, x: np.ndarray) -> np.ndarray:
+        r = self.residuals(x)
+        self.nfev += 1
+        self._last = (np.array(x, dtype=np.float64), r)
+        if self.known:
+            c = float(r @ r)
+            for xk, ck in self.known:
+                if c <= ck * (1 + JOIN_RTOL) and float(np.max(np.abs(x - xk) / self.span)) <= JOIN_XTOL:
+                    raise _Joined(np.array(x, dtype=np.float64), c)
+        return r
+
+    def at(self, x: np.ndarray) -> np.ndarray:
+        """The residuals at ``x``, reusing the last evaluation if it was there."""
+        if self._last is not None and np.array_equal(self._last[0], x):
+            return self._last[1]
+        return self(x)
+
+
+def _local(residuals, x0, packer, max_nfev, tol, known=(), const=None):
+    """A bounded least-squares run from ``x0``: ``(x, cost = Σ r², evaluations, joined)``.
+
+    ``known``: ``(x, cost)`` of minima found by earlier starts; a run that enters one's
+    basin (:data:`JOIN_XTOL`, :data:`JOIN_RTOL`) stops there. ``const``: the
+    :func:`constant_columns` of the Jacobian."""
     from scipy.optimize import least_squares
 
     x0 = np.clip(x0, packer.lb, packer.ub)
@@ -541,10 +671,39 @@ def _local(residuals, x0, packer, max_nfev, tol):
     # a model evaluated in float32 (a .brdf file's GLSL) declares a finite-difference step its
     # values can resolve; scipy's default (~1e-8 relative) would see no change at all
     diff_step = getattr(packer.cls, "fit_diff_step", None)
-    return least_squares(
-        residuals, x0, bounds=(packer.lb, packer.ub), method="trf", x_scale="jac", tr_solver="lsmr",
-        max_nfev=max_nfev, xtol=tol, ftol=tol, gtol=tol, diff_step=diff_step,
-    )
+    fn = _Start(residuals, packer, list(known))
+    jac = _jacobian(fn, packer, const) if const else "2-point"
+    try:
+        res = least_squares(
+            fn, x0, jac=jac, bounds=(packer.lb, packer.ub), method="trf", x_scale="jac", tr_solver="lsmr",
+            max_nfev=max_nfev, xtol=tol, ftol=tol, gtol=tol, diff_step=diff_step,
+        )
+    except _Joined as j:
+        return j.x, j.cost, fn.nfev, True
+    return res.x, float(2 * res.cost), fn.nfev, False
+
+
+#: a residual vector of at most this many samples is evaluated on one thread: the engine's
+#: parallel driver splits a call into chunks of 2048 pairs, and at a few thousand pairs a second
+#: thread per call saves nothing (3000 GGX pairs: 0.196 ms per call on two threads, 0.181 ms on
+#: one, measured on the shared 2-core machine) and a batch already runs one fit per core
+SERIAL_SAMPLES = 65536
+
+
+@contextmanager
+def _engine_threads(n_samples: int):
+    """Evaluate on one numba thread while fitting ``n_samples`` samples, if that is few."""
+    import numba
+
+    if n_samples > SERIAL_SAMPLES:
+        yield
+        return
+    before = numba.get_num_threads()
+    numba.set_num_threads(1)
+    try:
+        yield
+    finally:
+        numba.set_num_threads(before)
 
 
 #: Levenberg-Marquardt iterations of the table-scale polish
@@ -655,7 +814,7 @@ def fit(
                                                                       max_theta_deg=max_theta_deg)
     search = subsample(data, TABLE_SEARCH_SAMPLES, seed) if is_table else data
     T = _transform(metric)
-    residuals = _residual_fn(packer, search, T)
+    residuals = _residual_fn(packer, search, T, metric)
 
     def cost(x: np.ndarray) -> float:
         r = residuals(x)
@@ -671,12 +830,16 @@ def fit(
     # from here on the model is built from the free values
     rng = np.random.default_rng(seed + 1)
     nfev += 2 * (len(packer) + 1)  # _freeze_unused: at most 2 points × (base + one probe per slot)
-    _freeze_unused(packer, residuals, rng)
-    x_default = packer.x_of(packer.fixed)
-    cand = [x_default]
-    if candidates > 0:
-        cand += list(packer.random_x(rng, candidates))
-    costs = np.array([cost(x) for x in cand])
+    with _engine_threads(len(search)):
+        _freeze_unused(packer, residuals, rng)
+        x_default = packer.x_of(packer.fixed)
+        cand = [x_default]
+        if candidates > 0:
+            cand += list(packer.random_x(rng, candidates))
+        costs = np.array([cost(x) for x in cand])
+        # Jacobian columns known once for all (a float32-evaluated model's differences are too noisy)
+        const = {} if getattr(cls, "fit_diff_step", None) else constant_columns(residuals, packer, cand[:2])
+        nfev += 0 if getattr(cls, "fit_diff_step", None) else min(2, len(cand)) * (len(packer) + 1)
     nfev += len(cand)
     order = [0] + [int(i) for i in np.argsort(costs) if i != 0]
     chosen = order[:starts]
@@ -695,20 +858,23 @@ def fit(
         task = bar_ctx.add_task("fit", total=total)
     best_x, best_cost = None, math.inf
     start_errors = []
+    known: list[tuple[np.ndarray, float]] = []  # the minima the starts converged to
     try:
         for n_done, ci in enumerate(chosen, 1):
-            res = _local(residuals, cand[ci], packer, max_nfev or 100, tol)
-            nfev += int(res.nfev) + int(res.njev or 0) * len(packer)
-            cst = float(2 * res.cost)
+            with _engine_threads(len(search)):
+                x, cst, used, joined = _local(residuals, cand[ci], packer, max_nfev or 100, tol, known, const)
+            nfev += used
             start_errors.append(math.sqrt(cst))
+            if not joined:
+                known.append((x, cst))
             if cst < best_cost:
-                best_cost, best_x = cst, res.x
+                best_cost, best_x = cst, x
             if bar_ctx is not None:
                 bar_ctx.update(task, advance=1)
             if callback is not None:
                 callback(n_done, total)
         if search is not data:  # polish the best start on every bin
-            best_x, used = _polish(_residual_fn(packer, data, T), best_x, packer)
+            best_x, used = _polish(_residual_fn(packer, data, T, metric), best_x, packer)
             nfev += used
             if bar_ctx is not None:
                 bar_ctx.update(task, advance=1)
