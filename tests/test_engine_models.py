@@ -29,7 +29,7 @@ from brdfkit import engine
 from brdfkit.geometry import random_unit_vectors, spherical_to_vector
 
 #: models converted to the kernel protocol by the engine work (every built-in analytic model is meant to be)
-CONVERTED_HERE = ["lambert", "phong", "blinn-phong", "cook-torrance", "microfacet", "oren-nayar", "ward"]
+CONVERTED_HERE = ["lambert", "phong", "blinn-phong", "cook-torrance", "microfacet", "oren-nayar", "ward", "lafortune"]
 
 #: float32 twin vs float64 reference, relative (measured worst over the draws below: 3.0e-4, oren-nayar "full"
 #: at 89.99°; 1.1e-4 the dielectric Fresnel term of index 0.14 near its critical angle; 3e-5 Beckmann)
@@ -199,6 +199,7 @@ def test_array_wrappers_match_the_engine_under_the_reference(name):
     ("microfacet", {"shadowing": "v-groove", "fresnel": "schlick"}),
     ("ward", {}),
     ("lambert", {}),
+    ("lafortune", {"lobes": 3, "ks_2": 0.2, "cx_2": 0.5, "cy_2": 0.7, "n_2": 3.0, "ks_3": 0.1, "n_3": 200.0}),
     ("phong", {"shininess": 5000.0}),
     ("htsg", {}),
 ])
