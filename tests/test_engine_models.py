@@ -251,3 +251,8 @@ def test_float32_twin_maps_constants_by_role():
     assert f32_constant(1e300) == F32_CAP and np.isinf(f32_constant(math.inf))
     assert 4 * F32_FLOOR * F32_FLOOR >= np.finfo(np.float32).tiny  # a product of two floors stays normal
     assert np.isfinite(F32_CAP * np.float32(3.9))
+    from brdfkit.engine.precision import f32_params
+
+    got = f32_params(np.array([5e-324, -1e-40, 0.0, 0.25, 1e39, -math.inf]))
+    assert got.dtype == np.float32
+    assert got.tolist() == [F32_FLOOR, -F32_FLOOR, 0.0, 0.25, F32_CAP, -math.inf]

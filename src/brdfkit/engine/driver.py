@@ -319,7 +319,9 @@ def run(kernel: Callable, wi: np.ndarray, wo: np.ndarray, p: np.ndarray, c: np.n
     ft = np.float32 if f32 else np.float64
     lim = ft(np.finfo(out.dtype).max)
     if f32:
-        p = p.astype(np.float32)
+        from .precision import f32_params
+
+        p = f32_params(p)
     if n <= CHUNK:  # a single chunk runs inline, no thread pool: no lock needed
         driver_for(kernel, f32)._drive(wi, wo, p, c, out, lim, nrm)
         return nrm

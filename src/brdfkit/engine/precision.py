@@ -17,7 +17,8 @@ value (:func:`f32_constant`): a floor such as ``1e-150`` or ``1e-300`` — there
 that a product of two floored quantities stays a normal number — becomes
 ``sqrt(float32 tiny) ≈ 1.1e-19`` (the product of two is still normal), and a cap
 such as ``1e300`` becomes ``float32 max / 4 ≈ 8.5e37`` (the values the GLSL
-twins use). ``inf`` and ``nan`` stay what they are.
+twins use). ``inf`` and ``nan`` stay what they are. The parameters are mapped the
+same way (:func:`f32_params`).
 
 The builtin ``float(x)`` becomes a float32 cast in the twin. Integer constants and
 arguments (choice indices, loop counters) stay int64, and ``int op float32``
@@ -54,6 +55,22 @@ def f32_constant(v: float) -> np.float32:
     if a > float(F32_CAP):
         return np.float32(math.copysign(float(F32_CAP), v))
     return np.float32(v)
+
+
+def f32_params(p: np.ndarray) -> np.ndarray:
+    """A kernel's parameter array for its float32 twin: each value as :func:`f32_constant` maps it.
+
+    A parameter whose range is open at 0 (schlick's ``p``, down to 5e-324) would otherwise round to
+    0 and reach a division the float64 kernel never sees; it becomes :data:`F32_FLOOR` instead.
+    """
+    p = np.asarray(p, dtype=np.float64)
+    a = np.abs(p)
+    out = p.astype(np.float32)
+    small = (a > 0.0) & (a < float(_F32.tiny))
+    big = np.isfinite(p) & (a > float(F32_CAP))
+    out[small] = np.copysign(F32_FLOOR, p[small])
+    out[big] = np.copysign(F32_CAP, p[big])
+    return out
 
 
 def _convert(value):
@@ -135,4 +152,4 @@ def float64_variables(kernel: Callable) -> list[str]:
     return sorted(found)
 
 
-__all__ = ["float32_twin", "f32_constant", "float64_variables", "F32_FLOOR", "F32_CAP"]
+__all__ = ["float32_twin", "f32_constant", "f32_params", "float64_variables", "F32_FLOOR", "F32_CAP"]
