@@ -65,7 +65,8 @@ def f32_params(p: np.ndarray) -> np.ndarray:
     """
     p = np.asarray(p, dtype=np.float64)
     a = np.abs(p)
-    out = p.astype(np.float32)
+    with np.errstate(over="ignore"):  # the values that overflow are replaced below
+        out = p.astype(np.float32)
     small = (a > 0.0) & (a < float(_F32.tiny))
     big = np.isfinite(p) & (a > float(F32_CAP))
     out[small] = np.copysign(F32_FLOOR, p[small])
