@@ -251,8 +251,19 @@ def test_float32_twin_maps_constants_by_role():
     assert f32_constant(1e300) == F32_CAP and np.isinf(f32_constant(math.inf))
     assert 4 * F32_FLOOR * F32_FLOOR >= np.finfo(np.float32).tiny  # a product of two floors stays normal
     assert np.isfinite(F32_CAP * np.float32(3.9))
-    from brdfkit.engine.precision import f32_params
 
-    got = f32_params(np.array([5e-324, -1e-40, 0.0, 0.25, 1e39, -math.inf]))
-    assert got.dtype == np.float32
-    assert got.tolist() == [F32_FLOOR, -F32_FLOOR, 0.0, 0.25, F32_CAP, -math.inf]
+
+
+def test_parameters_outside_float32_are_computed_in_float64():
+    """A parameter float32 cannot hold (schlick's p = 5e-324, a weight of 1e-154) runs the float64 kernel."""
+    from brdfkit.engine.precision import fits_float32
+
+    assert fits_float32(np.array([0.0, 0.25, -3.0, math.inf, 1e30]))
+    assert not fits_float32(np.array([0.25, 5e-324])) and not fits_float32(np.array([1e39]))
+    wi, wo = _directions(3000, seed=11)
+    wi32, wo32 = wi.astype(np.float32), wo.astype(np.float32)
+    for m in (bk.model("schlick", p=5e-324), bk.model("lafortune", lobes=2, ks_2=1e-154, cx_2=-100.0,
+                                                       cy_2=-100.0, n_2=1e5)):
+        f = m.eval(wi32, wo32)
+        ref = m.eval(wi32.astype(np.float64), wo32.astype(np.float64)).astype(np.float32)
+        assert np.array_equal(f, ref), m  # the float64 value rounded once, as before the twin

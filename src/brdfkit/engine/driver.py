@@ -308,20 +308,24 @@ def run(kernel: Callable, wi: np.ndarray, wo: np.ndarray, p: np.ndarray, c: np.n
     Up to :data:`CHUNK` pairs: the generic driver (choices read at run time; one compile per
     kernel and dtype). More: the driver specialised for this choice combination, compiled on
     first use and cached on disk, whose loop LLVM vectorises. ``f32`` (float32 arrays only):
-    run the kernel's float32 twin, ``p`` rounded to float32.
+    run the kernel's float32 twin, ``p`` rounded to float32 — unless a parameter does not fit
+    float32 (:func:`.precision.fits_float32`), then the float64 kernel runs.
     """
     n = wi.shape[0]
     nrm = np.empty((nchunks(n), 6), dtype=np.float64)
     if n == 0:
         nrm[:] = [1.0, 1.0, 0.0, 1.0, 1.0, 0.0]
         return nrm
-    f32 = bool(f32) and out.dtype == np.float32
+    if f32 and out.dtype == np.float32:
+        from .precision import fits_float32
+
+        f32 = fits_float32(p)  # parameters outside float32's normal range: computed in float64
+    else:
+        f32 = False
     ft = np.float32 if f32 else np.float64
     lim = ft(np.finfo(out.dtype).max)
     if f32:
-        from .precision import f32_params
-
-        p = f32_params(p)
+        p = p.astype(np.float32)
     if n <= CHUNK:  # a single chunk runs inline, no thread pool: no lock needed
         driver_for(kernel, f32)._drive(wi, wo, p, c, out, lim, nrm)
         return nrm

@@ -17,8 +17,8 @@ value (:func:`f32_constant`): a floor such as ``1e-150`` or ``1e-300`` — there
 that a product of two floored quantities stays a normal number — becomes
 ``sqrt(float32 tiny) ≈ 1.1e-19`` (the product of two is still normal), and a cap
 such as ``1e300`` becomes ``float32 max / 4 ≈ 8.5e37`` (the values the GLSL
-twins use). ``inf`` and ``nan`` stay what they are. The parameters are mapped the
-same way (:func:`f32_params`).
+twins use). ``inf`` and ``nan`` stay what they are. Parameters are not mapped: a
+parameter set that does not fit float32 (:func:`fits_float32`) is computed in float64.
 
 The builtin ``float(x)`` becomes a float32 cast in the twin. Integer constants and
 arguments (choice indices, loop counters) stay int64, and ``int op float32``
@@ -57,21 +57,15 @@ def f32_constant(v: float) -> np.float32:
     return np.float32(v)
 
 
-def f32_params(p: np.ndarray) -> np.ndarray:
-    """A kernel's parameter array for its float32 twin: each value as :func:`f32_constant` maps it.
+def fits_float32(p: np.ndarray) -> bool:
+    """True when every parameter rounds to float32 as a normal number (or 0, ±inf): the twin may run.
 
-    A parameter whose range is open at 0 (schlick's ``p``, down to 5e-324) would otherwise round to
-    0 and reach a division the float64 kernel never sees; it becomes :data:`F32_FLOOR` instead.
+    Otherwise (schlick's ``p`` down to 5e-324, a weight of 1e-154) the float32 twin would see 0 or
+    a changed magnitude where the float64 kernel sees the value, so the driver computes in float64.
     """
-    p = np.asarray(p, dtype=np.float64)
-    a = np.abs(p)
-    with np.errstate(over="ignore"):  # the values that overflow are replaced below
-        out = p.astype(np.float32)
-    small = (a > 0.0) & (a < float(_F32.tiny))
-    big = np.isfinite(p) & (a > float(F32_CAP))
-    out[small] = np.copysign(F32_FLOOR, p[small])
-    out[big] = np.copysign(F32_CAP, p[big])
-    return out
+    a = np.abs(np.asarray(p, dtype=np.float64))
+    finite = a[np.isfinite(a)]
+    return not bool(np.any((finite > 0.0) & (finite < float(_F32.tiny))) or np.any(finite > float(F32_CAP)))
 
 
 def _convert(value):
@@ -153,4 +147,4 @@ def float64_variables(kernel: Callable) -> list[str]:
     return sorted(found)
 
 
-__all__ = ["float32_twin", "f32_constant", "f32_params", "float64_variables", "F32_FLOOR", "F32_CAP"]
+__all__ = ["float32_twin", "f32_constant", "fits_float32", "float64_variables", "F32_FLOOR", "F32_CAP"]
