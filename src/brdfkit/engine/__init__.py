@@ -59,7 +59,11 @@ How a model is converted (the kernel protocol)
    source: :func:`brdfkit.engine.vectorize` turns a scalar term into a ufunc-like
    function (float32 stays float32, computed in float64), never a second copy
    of the formula.
-5. Add the model to ``tests/test_engine_models.py`` (compiled vs reference for
+5. Mixing an int with a float (``x * (n - 1)``) promotes to float64 in numba also in the
+   float32 twin: write ``float(n - 1)`` (a float32 cast there); ``tests/test_engine_models.py``
+   fails on any float64 variable in a twin. ``kernel_float32 = False`` on the class keeps
+   float64 computation for float32 input.
+6. Add the model to ``tests/test_engine_models.py`` (compiled vs reference for
    every choice parameter) — or add its choice grid there.
 
 ``BRDF.eval`` also enforces the unit-direction rule of SPEC.md for every model,
@@ -67,9 +71,12 @@ whatever the engine: ``|wi|`` and ``|wo|`` within 1e-4 of 1 (float64) or 1e-3
 (float32), else ``ValueError`` naming the model, the argument and the worst
 length found.
 
-Numerics note: compiled kernels compute in float64 also for float32 input
-(numba types Python float literals as float64); float32 is the storage format
-of the fast path, and its values are the float64 result rounded once.
+Numerics note: for float32 input the compiled engine runs each kernel's float32
+twin (:mod:`.precision`: the same source rebuilt with float32 constants, so numba
+infers float32 throughout and LLVM vectorises 16 lanes), within a stated,
+condition-aware tolerance of the float64 reference (``tests/test_engine_models.py``).
+HTSG, the measured models, and parameter sets that do not fit float32 compute in
+float64 and round the result once. The reference engine always computes in float64.
 """
 
 from __future__ import annotations

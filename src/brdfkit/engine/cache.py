@@ -10,7 +10,9 @@ loads every kernel from disk (a new process pays no compile).
 
 Folder: ``$BRDFKIT_CACHE_DIR`` if set, else ``$XDG_CACHE_HOME/brdfkit`` (default
 ``~/.cache/brdfkit``), then ``numba-<hash>/``. If it cannot be created, numba
-falls back to its usual ``__pycache__`` locations.
+falls back to its usual ``__pycache__`` locations. When a process creates the folder
+of a new source version, folders of older versions unused for an hour are deleted
+(the most recent one is kept; :func:`prune`).
 """
 
 from __future__ import annotations
@@ -52,17 +54,69 @@ def cache_root() -> Path:
 _DIR: Path | None = None
 
 
+#: cache folders of other source versions are deleted once unused for this long (seconds) ...
+PRUNE_AFTER_S = 3600.0
+#: ... except this many of the most recently used ones besides the current
+KEEP_PREVIOUS = 1
+
+
 def cache_dir() -> Path:
-    """This source tree's numba cache folder (created on first use)."""
+    """This source tree's numba cache folder (created on first use; see :func:`prune`)."""
     global _DIR
     if _DIR is None:
         d = cache_root() / f"numba-{source_hash()}"
+        created = False
         try:
-            d.mkdir(parents=True, exist_ok=True)
+            d.mkdir(parents=True)
+            created = True
+        except FileExistsError:
+            with contextlib.suppress(OSError):
+                os.utime(d)  # the folder's mtime says when a process last used it
         except OSError:
             pass
         _DIR = d
+        if created:  # a new source version: the moment old folders may have gone stale
+            with contextlib.suppress(OSError):
+                prune(d)
     return _DIR
+
+
+def prune(current: Path, now: float | None = None) -> list[Path]:
+    """Delete the stale ``numba-*`` folders beside ``current``; returns those deleted.
+
+    Kept: ``current``, the :data:`KEEP_PREVIOUS` most recently used others, and every folder
+    used (its mtime, touched by each process that opens it) within :data:`PRUNE_AFTER_S` —
+    so a process of another source version that is running (another checkout, an old
+    server) keeps its kernels. A folder is first renamed to a hidden name (atomic: of two
+    processes pruning at once one wins, the other skips it), then removed; a process that
+    still opens the old name just recompiles into a fresh folder.
+    """
+    import shutil
+    import time
+
+    now = time.time() if now is None else now
+    root = current.parent
+    others = []
+    for d in root.glob("numba-*"):
+        if d == current or not d.is_dir():
+            continue
+        try:
+            others.append((d.stat().st_mtime, d))
+        except OSError:
+            continue
+    others.sort(reverse=True)
+    deleted = []
+    for mtime, d in others[KEEP_PREVIOUS:]:
+        if now - mtime < PRUNE_AFTER_S:
+            continue
+        trash = root / f".trash-{d.name}-{os.getpid()}"
+        try:
+            os.rename(d, trash)
+        except OSError:
+            continue
+        shutil.rmtree(trash, ignore_errors=True)
+        deleted.append(d)
+    return deleted
 
 
 @contextlib.contextmanager
@@ -133,4 +187,4 @@ class vectorize:
             return np.asarray(out).astype(dtype, copy=False)
 
 
-__all__ = ["jit", "vectorize", "cache_dir", "source_hash", "in_cache_dir", "JIT_OPTIONS"]
+__all__ = ["jit", "vectorize", "cache_dir", "prune", "source_hash", "in_cache_dir", "JIT_OPTIONS"]

@@ -28,6 +28,7 @@ table (longer than :data:`MAX_TUPLE`) keep the generic driver.
 
 from __future__ import annotations
 
+import contextlib
 import importlib.util
 import math
 import re
@@ -55,7 +56,7 @@ from {module} import {name} as _kernel
 
 # The kernel's own source, inlined into the loop by numba (IR inlining) rather than called:
 # LLVM's inliner leaves a big kernel out of line, and a call per pair costs ~8 % (issue 9).
-kernel = numba.njit(inline="always", error_model="numpy", nogil=True)(_kernel.py_func)
+{kernel_line}
 
 CHUNK = {chunk}
 
@@ -75,7 +76,7 @@ def span(wi, wo, p, c, out, lim, nrm, ch, lo, hi):
         bx = numba.float64(wo[j, 0])
         by = numba.float64(wo[j, 1])
         bz = numba.float64(wo[j, 2])
-        li = ax * ax + ay * ay + az * az  # squared lengths: the check needs no sqrt per pair
+        li = ax * ax + ay * ay + az * az  # squared lengths (float64): the check needs no sqrt per pair
         lo_ = bx * bx + by * by + bz * bz
         inan += li != li
         onan += lo_ != lo_
@@ -84,7 +85,7 @@ def span(wi, wo, p, c, out, lim, nrm, ch, lo, hi):
         omin = min(omin, lo_)
         omax = max(omax, lo_)
         if az > 0.0 and bz > 0.0:
-            r, g, b = kernel(ax, ay, az, bx, by, bz, p, c)
+            r, g, b = kernel({F}(wi[j, 0]), {F}(wi[j, 1]), {F}(wi[j, 2]), {F}(wo[j, 0]), {F}(wo[j, 1]), {F}(wo[j, 2]), p, c)
             out[j, 0] = min(r, lim)
             out[j, 1] = min(g, lim)
             out[j, 2] = min(b, lim)
@@ -120,9 +121,10 @@ import numba
 from {module} import {name} as _kernel
 
 # the kernel's own source, inlined into the loop (numba IR inlining), choices as constants
-kernel = numba.njit(inline="always", error_model="numpy", nogil=True)(_kernel.py_func)
+{kernel_line}
 C = {choices}
 CHUNK = {chunk}
+ZERO = {F}(0.0)
 
 
 @numba.njit(cache=True, error_model="numpy", nogil=True)
@@ -132,22 +134,22 @@ def span(wi, wo, p, out, lim, lo2, hi2, nrm, ch, lo, hi):
     o = out[3 * lo:3 * hi]
     bad = 0
     for j in range(hi - lo):  # branch-free: the kernel runs on every pair, a select writes 0 below the horizon
-        ax = numba.float64(a[3 * j])
-        ay = numba.float64(a[3 * j + 1])
-        az = numba.float64(a[3 * j + 2])
-        bx = numba.float64(b[3 * j])
-        by = numba.float64(b[3 * j + 1])
-        bz = numba.float64(b[3 * j + 2])
+        ax = {F}(a[3 * j])
+        ay = {F}(a[3 * j + 1])
+        az = {F}(a[3 * j + 2])
+        bx = {F}(b[3 * j])
+        by = {F}(b[3 * j + 1])
+        bz = {F}(b[3 * j + 2])
         li = ax * ax + ay * ay + az * az
         lo_ = bx * bx + by * by + bz * bz
         # pairs whose squared lengths are not safely inside the tolerance (NaN included): an integer
         # sum, which vectorises (a float min/max reduction does not); the caller redoes exact statistics
         bad += (li >= lo2) & (li <= hi2) & (lo_ >= lo2) & (lo_ <= hi2) == False
-        ok = (az > 0.0) & (bz > 0.0)
+        ok = (az > ZERO) & (bz > ZERO)
         r, g, bb = kernel(ax, ay, az, bx, by, bz, p, C)
-        o[3 * j] = min(r, lim) if ok else 0.0
-        o[3 * j + 1] = min(g, lim) if ok else 0.0
-        o[3 * j + 2] = min(bb, lim) if ok else 0.0
+        o[3 * j] = min(r, lim) if ok else ZERO
+        o[3 * j + 1] = min(g, lim) if ok else ZERO
+        o[3 * j + 2] = min(bb, lim) if ok else ZERO
     nrm[ch] = bad
 
 
@@ -164,6 +166,27 @@ _DRIVERS: dict[tuple, Callable] = {}
 _LOCK = threading.Lock()
 #: one parallel launch at a time (numba's workqueue layer is not reentrant across threads)
 _RUN_LOCK = threading.Lock()
+
+
+#: LLVM's loop-vectoriser width for the float32 specialised drivers: 16 lanes (one AVX-512 register).
+#: Its cost model picks 8 for them on this CPU (interleaved (n, 3) loads), which measured half the
+#: speed of 16 (README, "Speed"); float64 keeps the cost model's choice (16 measured slower there).
+F32_VECTOR_WIDTH = 16
+_COMPILED: set = set()
+
+
+@contextlib.contextmanager
+def _vector_width(width: int):
+    """LLVM's ``-force-vector-width`` while a driver compiles (a process-wide LLVM option: set, then reset to 0,
+    LLVM's default, "the cost model decides"). A numba compile elsewhere at the same moment would see it
+    too; that changes its speed, never its results."""
+    import llvmlite.binding as ll
+
+    ll.set_option("", f"-force-vector-width={width}")
+    try:
+        yield
+    finally:
+        ll.set_option("", "-force-vector-width=0")
 
 
 def nchunks(n: int) -> int:
@@ -197,8 +220,17 @@ def _load(key: tuple, stem: str, src: str) -> Callable:
         return mod.drive
 
 
-def _stem(py) -> str:
-    return "drv_" + re.sub(r"[^A-Za-z0-9_]", "_", f"{py.__module__}_{py.__name__}")
+def _stem(py, f32: bool = False) -> str:
+    return "drv_" + re.sub(r"[^A-Za-z0-9_]", "_", f"{py.__module__}_{py.__name__}") + ("__f32" if f32 else "")
+
+
+#: how a generated driver gets its kernel: the source itself (float64), or its float32 twin
+_KERNEL_LINE = {
+    False: 'kernel = numba.njit(inline="always", error_model="numpy", nogil=True)(_kernel.py_func)',
+    True: "from brdfkit.engine.precision import float32_twin\n"
+          "kernel = float32_twin(_kernel, inline=True)  # the same source, float32 constants",
+}
+_FTYPE = {False: "numba.float64", True: "numba.float32"}
 
 
 class _Stats:
@@ -219,80 +251,104 @@ class KernelDriver:
         self._key = key
         self._drive = drive
 
-
     def __call__(self, *args):
         return self._drive(*args)
 
     @property
     def stats(self) -> _Stats:
-        return _Stats([d for k, d in list(_DRIVERS.items()) if k[:2] == self._key])
+        return _Stats([d for k, d in list(_DRIVERS.items()) if k[:2] == self._key[:2]])
 
 
-_GENERIC: dict[Callable, KernelDriver] = {}
+_GENERIC: dict[tuple, KernelDriver] = {}
 
 
-def driver_for(kernel: Callable) -> KernelDriver:
-    """The generic compiled ``drive`` for ``kernel`` (runtime choices; generated, imported and memoised)."""
-    kd = _GENERIC.get(kernel)
+def driver_for(kernel: Callable, f32: bool = False) -> KernelDriver:
+    """The generic compiled ``drive`` for ``kernel`` (runtime choices; generated, imported and memoised).
+
+    ``f32``: the driver of the kernel's float32 twin (:mod:`.precision`), for float32 arrays.
+    """
+    kd = _GENERIC.get((kernel, f32))
     if kd is None:
         py = getattr(kernel, "py_func", kernel)
-        key = (py.__module__, py.__name__)
-        src = TEMPLATE.format(module=py.__module__, name=py.__name__, chunk=CHUNK)
-        kd = _GENERIC[kernel] = KernelDriver(key, _load(key, _stem(py), src))
+        key = (py.__module__, py.__name__, f32)
+        src = TEMPLATE.format(module=py.__module__, name=py.__name__, chunk=CHUNK,
+                              kernel_line=_KERNEL_LINE[f32], F=_FTYPE[f32])
+        kd = _GENERIC[(kernel, f32)] = KernelDriver(key, _load(key, _stem(py, f32), src))
     return kd
 
 
-def special_driver_for(kernel: Callable, choices: tuple[int, ...]) -> Callable:
+def special_driver_for(kernel: Callable, choices: tuple[int, ...], f32: bool = False) -> Callable:
     """The ``drive`` of ``kernel`` compiled for one combination of choice values (generated lazily, cached on disk)."""
     py = getattr(kernel, "py_func", kernel)
-    key = (py.__module__, py.__name__, choices)
+    key = (py.__module__, py.__name__, f32, choices)
     d = _DRIVERS.get(key)
     if d is not None:
         return d
-    src = SPECIAL_TEMPLATE.format(module=py.__module__, name=py.__name__, chunk=CHUNK, choices=repr(choices))
-    stem = _stem(py) + "__c" + "_".join(str(v) for v in choices)
+    src = SPECIAL_TEMPLATE.format(module=py.__module__, name=py.__name__, chunk=CHUNK, choices=repr(choices),
+                                  kernel_line=_KERNEL_LINE[f32], F=_FTYPE[f32])
+    stem = _stem(py, f32) + "__c" + "_".join(str(v) for v in choices)
     return _load(key, stem, src)
 
 
-def param_tuple(p: np.ndarray) -> tuple[float, ...]:
+def param_tuple(p: np.ndarray, ft=np.float64) -> tuple[float, ...]:
     """``p`` as a tuple (values LLVM keeps in registers: an array might alias the output), zero-padded
     to a power of two >= 32 so that one compiled specialisation serves every length up to it
-    (a kernel's dead branches may index past a short ``p``)."""
+    (a kernel's dead branches may index past a short ``p``). ``ft=np.float32``: float32 values."""
     n = len(p)
     size = max(32, 1 << max(0, n - 1).bit_length())
+    if ft is np.float32:
+        return tuple(np.asarray(p, dtype=np.float32)) + (np.float32(0.0),) * (size - n)
     return tuple(p.tolist()) + (0.0,) * (size - n)
 
 
-def run(kernel: Callable, wi: np.ndarray, wo: np.ndarray, p: np.ndarray, c: np.ndarray, out: np.ndarray) -> np.ndarray:
+def run(kernel: Callable, wi: np.ndarray, wo: np.ndarray, p: np.ndarray, c: np.ndarray, out: np.ndarray,
+        f32: bool = False) -> np.ndarray:
     """Evaluate ``kernel`` into ``out`` (flat ``(n, 3)``); returns the ``(nchunks, 6)`` squared-length statistics.
 
     Up to :data:`CHUNK` pairs: the generic driver (choices read at run time; one compile per
     kernel and dtype). More: the driver specialised for this choice combination, compiled on
-    first use and cached on disk, whose loop LLVM vectorises.
+    first use and cached on disk, whose loop LLVM vectorises. ``f32`` (float32 arrays only):
+    run the kernel's float32 twin, ``p`` rounded to float32 — unless a parameter does not fit
+    float32 (:func:`.precision.fits_float32`), then the float64 kernel runs.
     """
     n = wi.shape[0]
     nrm = np.empty((nchunks(n), 6), dtype=np.float64)
     if n == 0:
         nrm[:] = [1.0, 1.0, 0.0, 1.0, 1.0, 0.0]
         return nrm
-    lim = float(np.finfo(out.dtype).max)
+    if f32 and out.dtype == np.float32:
+        from .precision import fits_float32
+
+        f32 = fits_float32(p)  # parameters outside float32's normal range: computed in float64
+    else:
+        f32 = False
+    ft = np.float32 if f32 else np.float64
+    lim = ft(np.finfo(out.dtype).max)
+    if f32:
+        p = p.astype(np.float32)
     if n <= CHUNK:  # a single chunk runs inline, no thread pool: no lock needed
-        driver_for(kernel)._drive(wi, wo, p, c, out, lim, nrm)
+        driver_for(kernel, f32)._drive(wi, wo, p, c, out, lim, nrm)
         return nrm
     if len(p) > MAX_TUPLE:  # a table in p (measured data): the generic driver, p stays an array
         with _RUN_LOCK:
-            driver_for(kernel)._drive(wi, wo, p, c, out, lim, nrm)
+            driver_for(kernel, f32)._drive(wi, wo, p, c, out, lim, nrm)
         return nrm
     from .evaluate import UNIT_TOL
 
-    drive = special_driver_for(kernel, tuple(int(v) for v in c))
+    drive = special_driver_for(kernel, tuple(int(v) for v in c), f32)
     tol = UNIT_TOL[out.dtype]
-    # a band of squared lengths safely inside |w| in [1 - tol, 1 + tol] (margin >> rounding)
-    lo2 = (1.0 - tol) * (1.0 - tol) * (1.0 + 1e-9)
-    hi2 = (1.0 + tol) * (1.0 + tol) * (1.0 - 1e-9)
+    # a band of squared lengths safely inside |w| in [1 - tol, 1 + tol]: the margin is far above the
+    # rounding of x² + y² + z² in the working precision (and of the band's own rounding to it)
+    margin = 1e-5 if f32 else 1e-9
+    lo2 = ft((1.0 - tol) * (1.0 - tol) * (1.0 + margin))
+    hi2 = ft((1.0 + tol) * (1.0 + tol) * (1.0 - margin))
     bad = np.zeros(nrm.shape[0], dtype=np.int64)
-    with _RUN_LOCK:
-        drive(wi.reshape(-1), wo.reshape(-1), param_tuple(p), out.reshape(-1), lim, lo2, hi2, bad)
+    pt = param_tuple(p, ft)
+    first = f32 and (drive, len(pt)) not in _COMPILED  # this call may compile (or load) the driver
+    with _RUN_LOCK, (_vector_width(F32_VECTOR_WIDTH) if first else contextlib.nullcontext()):
+        drive(wi.reshape(-1), wo.reshape(-1), pt, out.reshape(-1), lim, lo2, hi2, bad)
+    if first:
+        _COMPILED.add((drive, len(pt)))
     if not bad.any():
         nrm[:] = [1.0, 1.0, 0.0, 1.0, 1.0, 0.0]  # every length within tolerance
     else:  # exact statistics (same formula as the generic driver), for check_unit and its message

@@ -95,7 +95,7 @@ def evaluate(model, wi, wo) -> np.ndarray:
         out = np.empty(shape, dtype=dtype)
         fout = out.reshape(-1, 3)
         if engine() == "compiled":
-            nrm = driver.run(kernel, fi, fo, p, c, fout)
+            nrm = driver.run(kernel, fi, fo, p, c, fout, f32=getattr(type(model), "kernel_float32", False))
             check_unit(name, "wi", math.sqrt(nrm[:, 0].min()), math.sqrt(nrm[:, 1].max()), int(nrm[:, 2].sum()), dtype)
             check_unit(name, "wo", math.sqrt(nrm[:, 3].min()), math.sqrt(nrm[:, 4].max()), int(nrm[:, 5].sum()), dtype)
         else:

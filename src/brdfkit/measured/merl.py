@@ -277,6 +277,8 @@ class MeasuredBRDF(BRDF):
 
     isotropic = True
     measured = True
+    #: tables and networks keep float64 computation also for float32 input (engine/precision.py is for analytic kernels)
+    kernel_float32 = False
 
     def _eval(self, wi, wo, p):
         # φd folded into [0, π) by reciprocity, as MERL stores it; the symmetric

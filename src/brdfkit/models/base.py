@@ -37,6 +37,8 @@ class BRDF:
     spec: ClassVar[tuple[Param, ...]] = ()
     #: the compiled scalar kernel (protocol: :mod:`brdfkit.engine`); None: ``_eval`` is used
     kernel: ClassVar[Any] = None
+    #: float32 input runs the kernel's float32 twin (brdfkit.engine.precision); False: computed in float64
+    kernel_float32: ClassVar[bool] = True
 
     def __init__(self, **params: Any) -> None:
         self.params: dict[str, Any] = validate(self.name, self.spec, params)

@@ -521,6 +521,7 @@ class HTSG(BRDF):
 
     # -- parts -------------------------------------------------------------
     kernel = staticmethod(htsg_kernel)
+    kernel_float32 = False  # the series (and its accuracy against mpmath) needs float64 also for float32 input
 
     def kernel_args(self):
         return self._pack(("sigma0", "tau", "eta", "k", "wavelengths", "kd", "ks"))

@@ -52,8 +52,11 @@ n_k         scalar  20         [0, 1e5]       exponent of lobe k (fitted in [1, 
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
+from ..engine import jit, vectorize
 from ..params import Param, kd_param
 from ..registry import register
 from .base import BRDF
@@ -61,19 +64,74 @@ from .base import BRDF
 MAX_LOBES = 3
 #: cap on n·ln d (keeps |C| > 1 with a large n finite; e^60 ≈ 1.1e26)
 LOG_CAP = 60.0
+#: parameters per lobe in the kernel's ``p``: ks (3), cx, cy, cz, n
+LOBE_STRIDE = 7
+
+
+# ------------------------------------------------------------ scalar sources
+@jit
+def generalized_dot_c(ux, uy, uz, vx, vy, vz, cx, cy, cz):
+    """Lafortune et al. 1997, eq. (5): ``Cx·u_x·v_x + Cy·u_y·v_y + Cz·u_z·v_z``."""
+    return cx * ux * vx + cy * uy * vy + cz * uz * vz
+
+
+@jit
+def cosine_lobe_c(d, n):
+    """``max(0, d)^n`` (eq. 4; 0 where ``d <= 0``, also for n = 0), as ``exp(min(n·ln d, LOG_CAP))``."""
+    if d <= 0.0:
+        return 0.0
+    return math.exp(min(n * math.log(d), LOG_CAP))
+
+
+@jit(inline=True)
+def lobe_c(wix, wiy, wiz, wox, woy, woz, p, o):
+    """The cosine lobe ``max(0, d_k)^n_k`` of the lobe whose parameters start at ``p[o]`` (ks at o..o+2)."""
+    d = generalized_dot_c(wix, wiy, wiz, wox, woy, woz, p[o + 3], p[o + 4], p[o + 5])
+    return cosine_lobe_c(d, p[o + 6])
+
+
+@jit
+def lafortune_kernel(wix, wiy, wiz, wox, woy, woz, p, c):
+    """Lafortune et al. (1997) eq. (6): ``kd/π + Σ_k ks_k · max(0, d_k)^n_k``, per RGB channel.
+
+    ``p = [kd (3), then per lobe k = 1..3: ks_k (3), cx_k, cy_k, cz_k, n_k]``; ``c = [lobes]``.
+    """
+    r = p[0] / math.pi
+    g = p[1] / math.pi
+    b = p[2] / math.pi
+    if c[0] >= 1:
+        L = lobe_c(wix, wiy, wiz, wox, woy, woz, p, 3)
+        r += p[3] * L
+        g += p[4] * L
+        b += p[5] * L
+    if c[0] >= 2:
+        L = lobe_c(wix, wiy, wiz, wox, woy, woz, p, 10)
+        r += p[10] * L
+        g += p[11] * L
+        b += p[12] * L
+    if c[0] >= 3:
+        L = lobe_c(wix, wiy, wiz, wox, woy, woz, p, 17)
+        r += p[17] * L
+        g += p[18] * L
+        b += p[19] * L
+    return r, g, b
+
+
+# ------------------------------------------------------ array API (wrappers)
+_v_dot = vectorize(generalized_dot_c, 9)
+_v_lobe = vectorize(cosine_lobe_c, 2)
 
 
 def generalized_dot(wi, wo, cx, cy, cz):
-    """Lafortune et al. 1997, eq. (5): ``Cx·u_x·v_x + Cy·u_y·v_y + Cz·u_z·v_z``."""
-    return cx * wi[..., 0] * wo[..., 0] + cy * wi[..., 1] * wo[..., 1] + cz * wi[..., 2] * wo[..., 2]
+    """Lafortune et al. 1997, eq. (5) over direction arrays. Scalar source: :func:`generalized_dot_c`."""
+    wi = np.asarray(wi)
+    wo = np.asarray(wo)
+    return _v_dot(wi[..., 0], wi[..., 1], wi[..., 2], wo[..., 0], wo[..., 1], wo[..., 2], cx, cy, cz)
 
 
 def cosine_lobe(d, n):
-    """``max(0, d)^n`` (0 where ``d <= 0``, also for n = 0), as ``exp(min(n·ln d, LOG_CAP))``."""
-    dt = d.dtype.type
-    pos = d > 0
-    t = np.minimum(dt(n) * np.log(np.where(pos, d, dt(1))), dt(LOG_CAP))
-    return np.where(pos, np.exp(t), dt(0))
+    """``max(0, d)^n`` elementwise (float64). Scalar source: :func:`cosine_lobe_c`."""
+    return _v_lobe(d, n)
 
 
 def _lobe_params(k: int, ks_default: float) -> tuple[Param, ...]:
@@ -105,10 +163,13 @@ class Lafortune(BRDF):
         *_lobe_params(3, 0.0),
     )
 
-    def _eval(self, wi, wo, p):
-        dt = wi.dtype.type
-        f = p["kd"] / dt(np.pi) + np.zeros(wi.shape, dt)
-        for k in range(1, int(p["lobes"]) + 1):
-            d = generalized_dot(wi, wo, p[f"cx_{k}"], p[f"cy_{k}"], p[f"cz_{k}"])
-            f = f + p[f"ks_{k}"] * cosine_lobe(d, p[f"n_{k}"])[..., None]
-        return f
+    kernel = staticmethod(lafortune_kernel)
+
+    def kernel_args(self):
+        p, _ = self._pack(("kd", "ks_1", "cx_1", "cy_1", "cz_1", "n_1", "ks_2", "cx_2", "cy_2", "cz_2", "n_2",
+                           "ks_3", "cx_3", "cy_3", "cz_3", "n_3"))
+        key = "lafortune_c"
+        c = self._cache.get(key)
+        if c is None:  # the lobe count as the kernel's choice (a specialised driver per count)
+            c = self._cache[key] = np.array([int(self.params["lobes"])], dtype=np.int64)
+        return p, c

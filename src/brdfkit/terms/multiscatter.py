@@ -108,9 +108,9 @@ def lookup_uniform(values, off, n, x):
     The per-direction lookup of the compiled microfacet kernel: the row of missing energies
     1 − E(μ_j) travels in the kernel's parameter array at offset ``off``.
     """
-    s = min(max(x, 0.0), 1.0) * (n - 1)
+    s = min(max(x, 0.0), 1.0) * float(n - 1)  # float(): the float32 twin's cast (engine/precision.py)
     i = min(int(math.floor(s)), n - 2)
-    t = s - i
+    t = s - float(i)
     return values[off + i] * (1.0 - t) + values[off + i + 1] * t
 
 
