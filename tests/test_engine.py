@@ -285,3 +285,19 @@ def test_a_new_source_version_prunes_on_first_use(tmp_path):
     out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True)
     names = sorted(p.name for p in tmp_path.iterdir())
     assert names == sorted([newer.name, out.stdout.strip()])  # the stale older one is gone, the newest other kept
+
+
+def test_forced_width_compile_hides_llvm_remarks_only():
+    """LLVM's "loop not vectorized" remarks during a forced-width compile never reach the user's
+    stderr; any other line written meanwhile still does (C-level fd 2, as LLVM writes it)."""
+    code = (
+        "import os\n"
+        "from brdfkit.engine.driver import _without_llvm_remarks\n"
+        "with _without_llvm_remarks():\n"
+        "    os.write(2, b'remark: <unknown>:0:0: loop not vectorized: call instruction cannot be vectorized\\n')\n"
+        "    os.write(2, b'a real warning\\n')\n"
+        "os.write(2, b'after\\n')\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert "remark:" not in out.stderr
+    assert out.stderr.splitlines() == ["a real warning", "after"]

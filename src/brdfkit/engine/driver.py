@@ -31,8 +31,10 @@ from __future__ import annotations
 import contextlib
 import importlib.util
 import math
+import os
 import re
 import sys
+import tempfile
 import threading
 from collections import Counter
 from typing import Callable
@@ -184,9 +186,39 @@ def _vector_width(width: int):
 
     ll.set_option("", f"-force-vector-width={width}")
     try:
-        yield
+        with _without_llvm_remarks():
+            yield
     finally:
         ll.set_option("", "-force-vector-width=0")
+
+
+@contextlib.contextmanager
+def _without_llvm_remarks():
+    """Hold back LLVM's "remark: ... loop not vectorized" lines while a forced-width driver compiles.
+
+    With ``-force-vector-width`` LLVM reports every loop it could not vectorise (those calling libm)
+    on the process's stderr, which a user of ``brdfkit eval`` would see once per driver. The C-level
+    stderr goes to a temporary file for the compile; afterwards every line that is not such a remark
+    (anything another thread wrote meanwhile) is written to stderr, so nothing else is lost."""
+    try:
+        fd = sys.__stderr__.fileno()
+    except (AttributeError, OSError, ValueError):  # pragma: no cover - no real stderr (embedded)
+        yield
+        return
+    sys.__stderr__.flush()
+    saved = os.dup(fd)
+    with tempfile.TemporaryFile() as tmp:
+        os.dup2(tmp.fileno(), fd)
+        try:
+            yield
+        finally:
+            os.dup2(saved, fd)
+            os.close(saved)
+            tmp.seek(0)
+            rest = [ln for ln in tmp.read().decode("utf-8", "replace").splitlines(True) if not ln.startswith("remark: ")]
+            if rest:
+                sys.__stderr__.write("".join(rest))
+                sys.__stderr__.flush()
 
 
 def nchunks(n: int) -> int:
