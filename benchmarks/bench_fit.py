@@ -5,6 +5,7 @@
     python benchmarks/bench_fit.py --batch         # the whole MERL batch (100 × 5) on 2 local workers
     python benchmarks/bench_fit.py --batch --save new.json --compare old.json   # and its losses vs another run's
     python benchmarks/bench_fit.py --starts-needed # how many starts reach the dense multi-start minimum
+    python benchmarks/bench_fit.py --per-call      # one residual evaluation: prepared vs model built per call
 
 Prints wall times (default settings of ``brdfkit fit``: 3000 samples, 4 starts, metric
 ngan), errors and evaluations used, and for a batch the CPU seconds its worker processes
@@ -17,6 +18,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import os
 import resource
 import shutil
@@ -81,6 +83,7 @@ def main() -> int:
     ap.add_argument("--n-materials", type=int, default=8, help="materials for --starts-needed")
     ap.add_argument("--save", help="with --batch: write its losses to this JSON file")
     ap.add_argument("--compare", help="with --batch: compare its losses with those saved in this JSON file")
+    ap.add_argument("--per-call", action="store_true", help="time one residual evaluation, prepared and not")
     ap.add_argument("--skip-single", action="store_true", help="skip the single and table-scale fits")
     args = ap.parse_args()
 
@@ -114,6 +117,8 @@ def main() -> int:
                 print("losses against", args.compare + ":", compare_losses(_losses(res), json.load(fh)))
     if args.starts_needed:
         starts_needed(args.n_materials)
+    if args.per_call:
+        per_call(args.material)
     return 0
 
 
@@ -138,6 +143,35 @@ def single(material: str) -> None:
         r = F.fit(name, material, fixed=fixed, data=tab, samples="table")
         print(f"table-scale fit, {name} ← {material}: {time.perf_counter() - w0:.2f} s, "
               f"error {r.error:.5g}, {r.nfev} evaluations")
+
+
+def per_call(material: str, calls: int = 100, repeats: int = 5) -> None:
+    """Wall time of one residual evaluation (3000 samples, default parameters, one numba thread as
+    in a fit), through the fitter's prepared evaluation and through ``packer.model(x).eval``."""
+    import numba
+
+    from brdfkit import registry
+
+    data = F.sample(material, n=3000)
+    T = F._transform("ngan")
+    numba.set_num_threads(1)
+    print(f"one residual evaluation, {len(data)} samples of {material} (best of {repeats} × {calls} calls):")
+    for name, fixed in MODELS:
+        packer = F.ParamPacker(registry.get(name), fixed)
+        x = packer.x_of(packer.fixed)
+        us = {}
+        for prepared in (False, True):
+            fn = F._residual_fn(packer, data, T, "ngan", prepared=prepared)
+            fn(x)
+            best = math.inf
+            for _ in range(repeats):
+                t0 = time.perf_counter()
+                for _ in range(calls):
+                    fn(x)
+                best = min(best, (time.perf_counter() - t0) / calls)
+            us[prepared] = best * 1e6
+        print(f"  {name:<20} model built per call {us[False]:6.0f} µs, prepared {us[True]:6.0f} µs")
+    print(f"  load average now {os.getloadavg()[0]:.2f}")
 
 
 def starts_needed(n_materials: int) -> None:

@@ -69,14 +69,11 @@ def _flat(a: np.ndarray, shape: tuple[int, ...]) -> np.ndarray:
     return np.ascontiguousarray(a).reshape(-1, 3)
 
 
-def evaluate(model, wi, wo) -> np.ndarray:
-    """The whole ``BRDF.eval`` contract for ``model`` (see :mod:`brdfkit.models.base`)."""
-    from . import engine
-    from . import driver, reference
-
+def prepare(name: str, wi, wo) -> tuple[np.ndarray, np.ndarray, tuple[int, ...], np.dtype]:
+    """``(fi, fo, shape, dtype)``: ``wi`` and ``wo`` in the working dtype, broadcast to ``shape`` and
+    flattened to C-contiguous ``(n, 3)`` arrays (the first steps of :func:`evaluate`; no unit check)."""
     wi = np.asarray(wi)
     wo = np.asarray(wo)
-    name = model.name
     if wi.shape[-1:] != (3,) or wo.shape[-1:] != (3,):
         raise ValueError(f"{name}: directions must have a last axis of length 3, got {wi.shape} and {wo.shape}")
     dtype = np.dtype(np.float32) if (wi.dtype == np.float32 and wo.dtype == np.float32) else np.dtype(np.float64)
@@ -86,25 +83,49 @@ def evaluate(model, wi, wo) -> np.ndarray:
         shape = np.broadcast_shapes(wi.shape, wo.shape)
     except ValueError:
         raise ValueError(f"{name}: wi of shape {wi.shape} and wo of shape {wo.shape} do not broadcast") from None
-    kernel = getattr(type(model), "kernel", None)
-    args = model.kernel_args() if kernel is not None else None
-    fi = _flat(wi, shape)
-    fo = _flat(wo, shape)
-    if args is not None:
-        p, c = args
-        out = np.empty(shape, dtype=dtype)
-        fout = out.reshape(-1, 3)
-        if engine() == "compiled":
-            nrm = driver.run(kernel, fi, fo, p, c, fout, f32=getattr(type(model), "kernel_float32", False))
-            check_unit(name, "wi", math.sqrt(nrm[:, 0].min()), math.sqrt(nrm[:, 1].max()), int(nrm[:, 2].sum()), dtype)
-            check_unit(name, "wo", math.sqrt(nrm[:, 3].min()), math.sqrt(nrm[:, 4].max()), int(nrm[:, 5].sum()), dtype)
-        else:
-            check_unit(name, "wi", *_length_stats_np(fi), dtype)
-            check_unit(name, "wo", *_length_stats_np(fo), dtype)
-            reference.run(kernel, fi, fo, p, c, fout)
-        return out
+    return _flat(wi, shape), _flat(wo, shape), shape, dtype
+
+
+def check_unit_flat(name: str, fi: np.ndarray, fo: np.ndarray, dtype) -> None:
+    """The unit-direction check of flat direction arrays (:func:`prepare`'s), without evaluating."""
     check_unit(name, "wi", *_length_stats_np(fi), dtype)
     check_unit(name, "wo", *_length_stats_np(fo), dtype)
+
+
+def run_kernel(model, kernel, args, fi: np.ndarray, fo: np.ndarray, fout: np.ndarray) -> np.ndarray | None:
+    """``kernel`` with ``args = (p, c)`` on flat directions into the flat ``fout``, by the active engine.
+
+    Returns the compiled driver's squared-length statistics (``None`` under the reference engine,
+    which evaluates without them)."""
+    from . import engine
+    from . import driver, reference
+
+    p, c = args
+    if engine() == "compiled":
+        return driver.run(kernel, fi, fo, p, c, fout, f32=getattr(type(model), "kernel_float32", False))
+    reference.run(kernel, fi, fo, p, c, fout)
+    return None
+
+
+def evaluate(model, wi, wo) -> np.ndarray:
+    """The whole ``BRDF.eval`` contract for ``model`` (see :mod:`brdfkit.models.base`)."""
+    name = model.name
+    fi, fo, shape, dtype = prepare(name, wi, wo)
+    kernel = getattr(type(model), "kernel", None)
+    args = model.kernel_args() if kernel is not None else None
+    if args is not None:
+        out = np.empty(shape, dtype=dtype)
+        fout = out.reshape(-1, 3)
+        from . import engine
+
+        if engine() != "compiled":  # the reference engine: checked before the (slow) evaluation
+            check_unit_flat(name, fi, fo, dtype)
+        nrm = run_kernel(model, kernel, args, fi, fo, fout)
+        if nrm is not None:
+            check_unit(name, "wi", math.sqrt(nrm[:, 0].min()), math.sqrt(nrm[:, 1].max()), int(nrm[:, 2].sum()), dtype)
+            check_unit(name, "wo", math.sqrt(nrm[:, 3].min()), math.sqrt(nrm[:, 4].max()), int(nrm[:, 5].sum()), dtype)
+        return out
+    check_unit_flat(name, fi, fo, dtype)
     return _fallback(model, fi.reshape(shape), fo.reshape(shape), dtype)
 
 
@@ -126,4 +147,4 @@ def _fallback(model, wi: np.ndarray, wo: np.ndarray, dtype) -> np.ndarray:
     return np.ascontiguousarray(f)
 
 
-__all__ = ["evaluate", "check_unit", "UNIT_TOL"]
+__all__ = ["evaluate", "check_unit", "UNIT_TOL"]  # prepare, check_unit_flat, run_kernel: for brdfkit.measured.fit
