@@ -52,6 +52,7 @@ from __future__ import annotations
 
 import functools
 import math
+import threading
 from dataclasses import dataclass
 from typing import Any
 
@@ -305,8 +306,17 @@ def _fold(wi: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None
     return wi[keep], np.where(up[keep], 2.0, 1.0) * w[keep]
 
 
+_PLAN_LOCK = threading.Lock()
+
+
+def _plan(*key):
+    """:func:`_build_plan`, cached; threads asking for the same plan build it once (``check --all --jobs``)."""
+    with _PLAN_LOCK:
+        return _build_plan(*key)
+
+
 @functools.lru_cache(maxsize=6)
-def _plan(theta: tuple, phi_o: float, level: str, charts: tuple, max_nodes: int, fold: bool = False):
+def _build_plan(theta: tuple, phi_o: float, level: str, charts: tuple, max_nodes: int, fold: bool = False):
     """The evaluation plan of :func:`albedo_result`, built once per angle set, level and charts.
 
     Returns the viewing directions ``wos`` (n, 3) and batches of at most about ``max_nodes``
