@@ -297,11 +297,10 @@ def run_checks(
 
     if jobs > 1 and len(work) > 1:
         import concurrent.futures as cf
+        import multiprocessing as mp
 
-        # threads, not processes: the engine's kernels release the GIL and already run on every
-        # core (one launch at a time), so the threads overlap one check's numpy and Python with
-        # another's kernel, and numba's cache is loaded once, not once per worker (issue 9)
-        with cf.ThreadPoolExecutor(max_workers=jobs) as ex:
+        ctx = mp.get_context("fork") if "fork" in mp.get_all_start_methods() else None
+        with cf.ProcessPoolExecutor(max_workers=jobs, mp_context=ctx) as ex:
             # the expensive model (htsg) first, so that the workers finish together
             order = sorted(range(len(work)), key=lambda i: work[i][0] != "htsg")
             futs = {ex.submit(_check_setting, work[i][0], work[i][1], level): i for i in order}
