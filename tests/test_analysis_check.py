@@ -197,3 +197,65 @@ def test_cli_check_all_json_and_plot(capsys, tmp_path, monkeypatch):
     assert main(["check", "--all", "--jobs", "1"]) == 0
     table = capsys.readouterr().out
     assert "lambert" in table and "phong" in table and "NO" in table
+
+
+# --- issue 9: the mirror fold of the albedo rules changes no figure beyond rounding
+
+
+def _figures(r):
+    out = [("max_albedo", r["max_albedo"], r["integration_error"])]
+    for curve in ("albedo", "albedo_light"):
+        if curve in r:
+            for th, rgb, err in zip(r[curve]["theta_deg"], r[curve]["rgb"], r[curve]["error"]):
+                out += [(f"{curve}@{th:g}", v, err) for v in rgb]
+    return out
+
+
+@pytest.mark.parametrize(
+    "name, setting",
+    [
+        ("htsg", {}),
+        ("phong", {"kd": 0.0, "ks": 1.0, "shininess": 1e4, "normalized": False}),
+        ("ward", {"kd": 0.0, "ks": 1.0, "alpha_x": 0.001, "alpha_y": 0.01, "normalization": "ward"}),
+        ("oren-nayar", {"kd": 1.0, "sigma": 1.0, "variant": "full"}),
+        ("cook-torrance", {"kd": 0.0, "ks": 1.0, "m": 0.001, "ior": 1000.0}),
+    ],
+)
+def test_mirror_fold_agrees_with_the_full_rules(name, setting, monkeypatch):
+    from brdfkit.analysis import verdict
+
+    m = bk.model(name, **setting)
+    assert verdict.mirror_symmetric(m)
+    folded = check(m, level="fast")
+    monkeypatch.setattr(verdict, "mirror_symmetric", lambda model: False)
+    full = check(m, level="fast")
+    assert folded["energy_conserving"] == full["energy_conserving"]
+    assert folded["max_albedo_theta_deg"] == full["max_albedo_theta_deg"]
+    for (what, a, ea), (_, b, eb) in zip(_figures(folded), _figures(full)):
+        assert abs(a - b) <= max(ea, eb), (what, a, b, ea, eb)
+        assert ea <= 1.01 * eb + 1e-15, (what, ea, eb)  # the error estimate is not worse
+
+
+class _Chiral:
+    """Rotation invariant, not mirror symmetric: f grows with (wi × wo)·n."""
+
+    isotropic = True
+
+    def eval(self, wi, wo):
+        wi, wo = np.broadcast_arrays(np.asarray(wi, float), np.asarray(wo, float))
+        cz = wi[..., 0] * wo[..., 1] - wi[..., 1] * wo[..., 0]
+        f = (1.0 + 0.5 * cz) / math.pi * (wi[..., 2] > 0) * (wo[..., 2] > 0)
+        return np.repeat(f[..., None], 3, axis=-1)
+
+
+def test_mirror_test_rejects_a_chiral_model_and_fold_rejects_an_asymmetric_rule():
+    from brdfkit.analysis import verdict
+    from brdfkit.analysis.albedo import _fold, half_vector_rule
+
+    assert not verdict.mirror_symmetric(_Chiral())
+    assert verdict.mirror_symmetric(bk.model("lambert"))
+    wi, w = half_vector_rule(0.7, 0.0, 5, 32)
+    half = _fold(wi, w)
+    assert half is not None and half[0].shape[0] < 0.6 * wi.shape[0]
+    assert abs(half[1].sum() - w.sum()) <= 1e-12 * w.sum()
+    assert _fold(*half_vector_rule(0.7, 0.3, 5, 32)) is None  # wo off the plane y = 0
