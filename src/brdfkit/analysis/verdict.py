@@ -31,21 +31,25 @@ def _curve(model: Any, theta: np.ndarray, phis: Iterable[float], over: str, leve
     return v, e
 
 
-def effectively_isotropic(model: Any, tol: float = 1e-9) -> bool:
-    """True when f(Rwi, Rwo) = f(wi, wo) for rotations R about the normal (tested numerically).
-
-    An anisotropic model at isotropic settings (alpha_x = alpha_y) then needs a
-    single azimuth in the albedo scan.
-    """
-    rng = np.random.default_rng(7)
-    n = 2000
+def _upper_pairs(n: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
+    """``n`` random pairs of unit directions above the horizon (cos θ in [0.001, 1), uniform in cos θ and φ)."""
+    rng = np.random.default_rng(seed)
     pts = []
     for _ in range(2):
         u = rng.random((n, 2))
         z = u[:, 0] * 0.999 + 0.001
         r = np.sqrt(1 - z * z)
         pts.append(np.stack([r * np.cos(2 * math.pi * u[:, 1]), r * np.sin(2 * math.pi * u[:, 1]), z], -1))
-    a, b = pts
+    return pts[0], pts[1]
+
+
+def effectively_isotropic(model: Any, tol: float = 1e-9) -> bool:
+    """True when f(Rwi, Rwo) = f(wi, wo) for rotations R about the normal (tested numerically).
+
+    An anisotropic model at isotropic settings (alpha_x = alpha_y) then needs a
+    single azimuth in the albedo scan.
+    """
+    a, b = _upper_pairs(2000, seed=7)
     f0 = np.asarray(model.eval(a, b), dtype=np.float64)
     scale = float(np.abs(f0).max()) or 1.0
     for ang in (0.7, 1.9, 2.9, 4.4):
@@ -68,15 +72,8 @@ def mirror_symmetric(model: Any, tol: float = MIRROR_TOL) -> bool:
     (isotropic models, and anisotropic ones aligned with the tangent frame); the albedo
     at φo = 0 then needs only the half y ≥ 0 of each quadrature rule (issue 9).
     """
-    rng = np.random.default_rng(11)
     n = 3000
-    pts = []
-    for _ in range(2):
-        u = rng.random((n, 2))
-        z = u[:, 0] * 0.999 + 0.001
-        r = np.sqrt(1 - z * z)
-        pts.append(np.stack([r * np.cos(2 * math.pi * u[:, 1]), r * np.sin(2 * math.pi * u[:, 1]), z], -1))
-    a, b = pts
+    a, b = _upper_pairs(n, seed=11)
     m = np.array([1.0, -1.0, 1.0])
     f = np.asarray(model.eval(np.concatenate([a, a * m]), np.concatenate([b, b * m])), dtype=np.float64)
     f0, f1 = f[:n], f[n:]
