@@ -550,7 +550,7 @@ class _PreparedEval:
         self.packer, self.data = packer, data
         cls = packer.cls
         self.kernel = getattr(cls, "kernel", None)
-        self.unvalidated = cls.__init__ is BRDF.__init__  # building skips only validate() (see model)
+        self.unvalidated = cls.__init__ is BRDF.__init__  # _from_valid equals __init__ only then
         self.fi, self.fo, shape, dtype = prepare(cls.name, data.wi, data.wo)
         if self.kernel is not None:
             check_unit_flat(cls.name, self.fi, self.fo, dtype)
@@ -570,11 +570,7 @@ class _PreparedEval:
         for k, v in params.items():
             if isinstance(v, np.ndarray) and v.flags.writeable:  # validate() returns read-only rgb
                 v.setflags(write=False)
-        m = object.__new__(packer.cls)  # BRDF.__init__ without validate()
-        m.params = params
-        m._cache = {}
-        m._setup()
-        return m
+        return packer.cls._from_valid(params)
 
     def __call__(self, x: np.ndarray) -> np.ndarray:
         from ..engine.evaluate import run_kernel
@@ -909,8 +905,10 @@ def fit(
             cand += list(packer.random_x(rng, candidates))
         costs = np.array([cost(x) for x in cand])
         # Jacobian columns known once for all (a float32-evaluated model's differences are too noisy)
-        const = {} if getattr(cls, "fit_diff_step", None) else constant_columns(residuals, packer, cand[:2])
-        nfev += 0 if getattr(cls, "fit_diff_step", None) else min(2, len(cand)) * (len(packer) + 1)
+        const = {}
+        if not getattr(cls, "fit_diff_step", None):
+            const = constant_columns(residuals, packer, cand[:2])
+            nfev += min(2, len(cand)) * (len(packer) + 1)
     nfev += len(cand)
     order = [0] + [int(i) for i in np.argsort(costs) if i != 0]
     chosen = order[:starts]

@@ -41,7 +41,20 @@ class BRDF:
     kernel_float32: ClassVar[bool] = True
 
     def __init__(self, **params: Any) -> None:
-        self.params: dict[str, Any] = validate(self.name, self.spec, params)
+        self._init_valid(validate(self.name, self.spec, params))
+
+    @classmethod
+    def _from_valid(cls, params: dict[str, Any]) -> "BRDF":
+        """The model of ``params`` already in the form ``validate`` returns (every value checked, in
+        the spec's order, rgb values read-only arrays), without checking them again: for a hot loop
+        that keeps its values inside the spec (the fitter's prepared evaluation). A class whose
+        ``__init__`` does more than validate must not be built this way."""
+        m = object.__new__(cls)
+        m._init_valid(params)
+        return m
+
+    def _init_valid(self, params: dict[str, Any]) -> None:
+        self.params: dict[str, Any] = params
         self._cache: dict[Any, dict[str, Any]] = {}
         self._setup()
 
