@@ -98,8 +98,8 @@ def f_conductor(c, eta, k):
     rs = qa / ds
     br = (m1 + 2.0) * c2 - 1.0  # Re((η² + 1) c² − 1)
     bi = Q * c2
-    rp = qa * math.sqrt(br * br + bi * bi) / dp
-    F = 0.5 * (rs * rs + rp * rp)
+    qp = qa / dp
+    F = 0.5 * (rs * rs + qp * qp * (br * br + bi * bi))  # |r_p|² without the modulus's sqrt
     return min(max(F, 0.0), 1.0)
 
 
