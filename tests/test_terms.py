@@ -346,3 +346,22 @@ def test_conductor_accuracy_against_mpmath(eta, k):
     # a (near-)index-1 interface at a tiny cosine stays finite in float32
     tiny = fr.fresnel_conductor(np.float32([1e-12, 1e-30, 0.0]), np.float32(1.0), np.float32(0.0))
     assert np.all(np.isfinite(tiny)) and np.all(tiny == 0)
+
+
+def test_ggx_smith_separable_from_parts_is_the_product_of_g1():
+    """G1(wi)·G1(wo) from GGX's undivided Λ = num/den (one division) equals g1_smith(Λi)·g1_smith(Λo)."""
+    from brdfkit.geometry import random_unit_vectors
+
+    rng = np.random.default_rng(4)
+    w = random_unit_vectors(4000, rng)
+    w[:, 2] = np.abs(w[:, 2])
+    w[:10, 2] = [0.0, -0.1, 1e-300, 5e-324, 1e-12, 1.0, 1e-6, 0.5, 1e-200, 0.9]
+    for ax, ay in ((0.3, 0.3), (1e-3, 1.0), (0.05, 0.7)):
+        for j in range(0, len(w) - 1, 2):
+            a, b = w[j], w[j + 1]
+            li = dist.lambda_ggx(*a, ax, ay)
+            lo = dist.lambda_ggx(*b, ax, ay)
+            want = sh.g1_smith(li) * sh.g1_smith(lo)
+            got = sh.g_smith_separable_parts(*dist.lambda_ggx_parts(*a, ax, ay), *dist.lambda_ggx_parts(*b, ax, ay))
+            assert 0.0 <= got <= 1.0
+            assert abs(got - want) <= 1e-15 * max(want, 1e-300) or (want < 1e-290 and got < 1e-290), (a, b, got, want)

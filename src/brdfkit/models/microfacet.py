@@ -76,9 +76,9 @@ from ..engine import jit
 from ..geometry import half_vector_c
 from ..params import Param, kd_param, ks_param
 from ..registry import register
-from ..terms.distributions import d_of, lambda_of
+from ..terms.distributions import GGX, d_of, lambda_ggx_parts, lambda_of
 from ..terms.fresnel import f_conductor, f_dielectric, f_schlick, fresnel_conductor, fresnel_dielectric_cook, fresnel_schlick
-from ..terms.shadowing import g1_smith, g_vgroove
+from ..terms.shadowing import g1_smith, g_smith_separable_parts, g_vgroove
 from ..terms import multiscatter as _ms
 from ..terms.multiscatter import N_MU, compensation, lookup_uniform
 from .base import BRDF
@@ -157,6 +157,10 @@ def shadowing_of(kind, dist, wix, wiy, wiz, wox, woy, woz, hz, lh, vh, ax, ay):
     """G for the ``shadowing`` choice index ``kind``: separable Smith, height-correlated Smith, V-groove."""
     if kind == V_GROOVE:
         return g_vgroove(hz, woz, wiz, vh, lh)
+    if kind == SMITH and dist == GGX:  # GGX's Λ is a ratio: G1·G1 with one division
+        ni, di = lambda_ggx_parts(wix, wiy, wiz, ax, ay)
+        no, do = lambda_ggx_parts(wox, woy, woz, ax, ay)
+        return g_smith_separable_parts(ni, di, no, do)
     lam_i = lambda_of(dist, wix, wiy, wiz, ax, ay)
     lam_o = lambda_of(dist, wox, woy, woz, ax, ay)
     if kind == SMITH:

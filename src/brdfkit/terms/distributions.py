@@ -81,8 +81,8 @@ _SQRT_PI = math.sqrt(math.pi)
 @jit
 def slope2(hx, hy, ax, ay):
     """``h_x²/α_x² + h_y²/α_y²`` (= tan²θ_h/α(h)² · h_z²)."""
-    u = hx / ax
-    v = hy / ay
+    u = hx * (1.0 / ax)  # a reciprocal of the constant roughness (hoisted out of a loop), not a division per pair
+    v = hy * (1.0 / ay)
     return u * u + v * v
 
 
@@ -133,6 +133,14 @@ def d_ggx(hx, hy, hz, ax, ay):
 
 
 @jit
+def projected_slope2(wx, wy, ax, ay):
+    """``s² = w_x² α_x² + w_y² α_y²`` (the square of :func:`projected_slope`, without its sqrt)."""
+    u = wx * ax
+    v = wy * ay
+    return u * u + v * v
+
+
+@jit
 def projected_slope(wx, wy, ax, ay):
     """``s = sqrt(w_x² α_x² + w_y² α_y²)``, so that ``α(w) tan θ = s / w_z`` (Heitz 2014, eq. 80)."""
     u = wx * ax
@@ -160,18 +168,29 @@ def lambda_beckmann(wx, wy, wz, ax, ay):
 
 
 @jit
+def lambda_ggx_parts(wx, wy, wz, ax, ay):
+    """``(num, den)`` with the GGX Smith ``Λ = num/den = s²/(2 w_z (sqrt(w_z² + s²) + w_z))`` (Walter 2007, eq. 34).
+
+    The ratio left undivided, so that a caller forming ``G1 = 1/(1 + Λ) = den/(den + num)`` (or a
+    product of two) divides once (a division is the costliest instruction of a vectorised kernel).
+    ``den >= 0``; ``den = 0`` (``w_z <= 0``, or an underflow at ``w_z ~ 5e-324``) means Λ = +inf.
+    """
+    if wz <= 0.0:
+        return 1.0, 0.0
+    s2 = projected_slope2(wx, wy, ax, ay)
+    return s2, max(2.0 * wz * (math.sqrt(wz * wz + s2) + wz), 0.0)
+
+
+@jit
 def lambda_ggx(wx, wy, wz, ax, ay):
     """Exact Smith Λ of GGX, ``(−1 + sqrt(1 + s²/w_z²))/2`` as ``s²/(2 w_z (sqrt(w_z² + s²) + w_z))`` (Walter 2007, eq. 34).
 
     0 at normal incidence, +inf for ``w_z <= 0``; no cancellation.
     """
-    if wz <= 0.0:
-        return math.inf
-    s = projected_slope(wx, wy, ax, ay)
-    den = 2.0 * wz * (math.sqrt(wz * wz + s * s) + wz)
+    num, den = lambda_ggx_parts(wx, wy, wz, ax, ay)
     if den <= 0.0:
-        return math.inf  # the denominator underflowed (w_z ~ 5e-324 at small α): fully masked, G1 = 0
-    return (s * s) / den
+        return math.inf  # below the horizon, or the denominator underflowed: fully masked, G1 = 0
+    return num / den
 
 
 #: ``distribution`` choice indices used by the kernels (the order of microfacet's ``choices``)
@@ -345,6 +364,7 @@ __all__ = [
     "projected_slope",
     "lambda_beckmann",
     "lambda_ggx",
+    "lambda_ggx_parts",
     "d_of",
     "lambda_of",
     "BECKMANN",
