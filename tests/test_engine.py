@@ -214,6 +214,24 @@ def test_scalar_half_vector_matches_the_array_one_at_grazing():
         assert pure(*map(float, wi[j]), *map(float, wo[j])) == hc
 
 
+def test_half_vector_of_a_subnormal_sum_is_the_normal_in_both_precisions():
+    """wi + wo with a subnormal largest component: the reciprocal 1/m of the scaled sum stays finite
+    (m is raised to the smallest normal number, float32's in the twin), so h is +z, never NaN."""
+    from brdfkit import geometry as g
+    from brdfkit.engine.precision import float32_twin
+
+    twin = float32_twin(g.half_vector_c)
+    for ft, z in ((np.float64, 5e-324), (np.float64, 1e-310), (np.float32, 1.4e-45), (np.float32, 1e-40)):
+        f = g.half_vector_c if ft is np.float64 else twin
+        args = [ft(v) for v in (1.0, 0.0, z, -1.0, 0.0, z)]
+        assert ft(z) > 0 and ft(z) < np.finfo(ft).tiny
+        h = f(*args)
+        assert h == (0.0, 0.0, 1.0), (ft, z, h)
+        sx, sy, sz, m = (g.scaled_sum_c if ft is np.float64 else float32_twin(g.scaled_sum_c))(*args)
+        assert m == np.finfo(ft).tiny and 0 < sz < 1 and sx == sy == 0.0
+        assert np.isclose(float(sz) * float(m), 2 * float(ft(z)), rtol=1e-6)  # S·m is still wi + wo
+
+
 def test_term_array_wrappers_run_the_scalar_source_on_both_engines(restore_engine):
     """terms.* array functions: compiled ufuncs and, under the reference engine, the same Python functions."""
     from brdfkit.terms import distributions as D

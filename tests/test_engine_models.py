@@ -249,6 +249,9 @@ def test_float32_twin_maps_constants_by_role():
     assert f32_constant(0.5) == np.float32(0.5) and f32_constant(0.5).dtype == np.float32
     assert f32_constant(1e-150) == F32_FLOOR and f32_constant(-1e-300) == -F32_FLOOR
     assert f32_constant(1e300) == F32_CAP and np.isinf(f32_constant(math.inf))
+    # the smallest normal float64 (geometry.NORMAL_MIN, keeping 1/m finite) becomes the smallest normal float32
+    assert f32_constant(float(np.finfo(np.float64).tiny)) == np.finfo(np.float32).tiny
+    assert f32_constant(2 * float(np.finfo(np.float64).tiny)) == F32_FLOOR  # other floors keep theirs
     assert 4 * F32_FLOOR * F32_FLOOR >= np.finfo(np.float32).tiny  # a product of two floors stays normal
     assert np.isfinite(F32_CAP * np.float32(3.9))
 

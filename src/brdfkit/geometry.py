@@ -21,6 +21,8 @@ import numpy as np
 from .engine import jit
 
 _TINY = 1e-300
+#: float64's smallest normal number (a float32 twin uses float32's: brdfkit.engine.precision)
+NORMAL_MIN = 2.2250738585072014e-308
 
 
 # ------------------------------------------------ scalar forms for the kernels
@@ -36,7 +38,8 @@ def dot3(ax, ay, az, bx, by, bz):
 def scaled_sum_c(ix, iy, iz, ox, oy, oz):
     """``(S_x, S_y, S_z, m)``: ``S = (wi + wo)/m`` with ``m`` the largest absolute component; scalar twin of :func:`scaled_sum`.
 
-    ``|S|`` lies in ``[1, √3]``, so normalising it neither underflows nor
+    ``|S|`` lies in ``[1, √3]`` (for a subnormal largest component, ``m`` is the smallest normal
+    number and ``|S|`` smaller, never near underflow), so normalising it neither underflows nor
     overflows; ``S = +z``, ``m = 0`` where ``wi == −wo``.
     """
     sx = ix + ox
@@ -45,15 +48,20 @@ def scaled_sum_c(ix, iy, iz, ox, oy, oz):
     m = max(abs(sx), max(abs(sy), abs(sz)))
     if m == 0.0:
         return 0.0, 0.0, 1.0, 0.0
-    return sx / m, sy / m, sz / m, m
+    # one reciprocal, three products (a division is the costliest instruction of a vectorised
+    # kernel); m is raised to the smallest normal number first, so that 1/m stays finite: a
+    # subnormal m then gives |S| < 1, still far from underflow, and S·m is still wi + wo
+    m = max(m, NORMAL_MIN)
+    r = 1.0 / m
+    return sx * r, sy * r, sz * r, m
 
 
 @jit
 def half_vector_c(ix, iy, iz, ox, oy, oz):
     """``normalize(wi + wo)`` in component form, robust at grazing angles: the scalar twin of :func:`half_vector`."""
     sx, sy, sz, m = scaled_sum_c(ix, iy, iz, ox, oy, oz)
-    n = math.sqrt(sx * sx + sy * sy + sz * sz)
-    return sx / n, sy / n, sz / n
+    r = 1.0 / math.sqrt(sx * sx + sy * sy + sz * sz)  # |S| in [1, √3]: one reciprocal, three products
+    return sx * r, sy * r, sz * r
 
 
 def dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
