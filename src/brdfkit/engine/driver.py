@@ -63,7 +63,7 @@ from {module} import {name} as _kernel
 CHUNK = {chunk}
 
 
-@numba.njit(cache=True, error_model="numpy", nogil=True)
+@numba.njit(cache=True, error_model="numpy", nogil=True, fastmath={FM})
 def span(wi, wo, p, c, out, lim, nrm, ch, lo, hi):
     imin = math.inf
     imax = -math.inf
@@ -103,7 +103,7 @@ def span(wi, wo, p, c, out, lim, nrm, ch, lo, hi):
     nrm[ch, 5] = onan
 
 
-@numba.njit(cache=True, parallel=True, error_model="numpy", nogil=True)
+@numba.njit(cache=True, parallel=True, error_model="numpy", nogil=True, fastmath={FM})
 def drive(wi, wo, p, c, out, lim, nrm):
     n = wi.shape[0]
     nchunks = (n + CHUNK - 1) // CHUNK
@@ -129,7 +129,7 @@ CHUNK = {chunk}
 ZERO = {F}(0.0)
 
 
-@numba.njit(cache=True, error_model="numpy", nogil=True)
+@numba.njit(cache=True, error_model="numpy", nogil=True, fastmath={FM})
 def span(wi, wo, p, out, lim, lo2, hi2, nrm, ch, lo, hi):
     a = wi[3 * lo:3 * hi]
     b = wo[3 * lo:3 * hi]
@@ -155,7 +155,7 @@ def span(wi, wo, p, out, lim, lo2, hi2, nrm, ch, lo, hi):
     nrm[ch] = bad
 
 
-@numba.njit(cache=True, parallel=True, error_model="numpy", nogil=True)
+@numba.njit(cache=True, parallel=True, error_model="numpy", nogil=True, fastmath={FM})
 def drive(wi, wo, p, out, lim, lo2, hi2, nrm):
     n = wi.shape[0] // 3
     nchunks = (n + CHUNK - 1) // CHUNK
@@ -263,6 +263,8 @@ _KERNEL_LINE = {
           "kernel = float32_twin(_kernel, inline=True)  # the same source, float32 constants",
 }
 _FTYPE = {False: "numba.float64", True: "numba.float32"}
+#: fast-math flags of the generated drivers: float32 ones FMA-contract like the twins they inline
+_FASTMATH = {False: "False", True: "{'contract'}"}
 
 
 class _Stats:
@@ -304,7 +306,7 @@ def driver_for(kernel: Callable, f32: bool = False) -> KernelDriver:
         py = getattr(kernel, "py_func", kernel)
         key = (py.__module__, py.__name__, f32)
         src = TEMPLATE.format(module=py.__module__, name=py.__name__, chunk=CHUNK,
-                              kernel_line=_KERNEL_LINE[f32], F=_FTYPE[f32])
+                              kernel_line=_KERNEL_LINE[f32], F=_FTYPE[f32], FM=_FASTMATH[f32])
         kd = _GENERIC[(kernel, f32)] = KernelDriver(key, _load(key, _stem(py, f32), src))
     return kd
 
@@ -317,7 +319,7 @@ def special_driver_for(kernel: Callable, choices: tuple[int, ...], f32: bool = F
     if d is not None:
         return d
     src = SPECIAL_TEMPLATE.format(module=py.__module__, name=py.__name__, chunk=CHUNK, choices=repr(choices),
-                                  kernel_line=_KERNEL_LINE[f32], F=_FTYPE[f32])
+                                  kernel_line=_KERNEL_LINE[f32], F=_FTYPE[f32], FM=_FASTMATH[f32])
     stem = _stem(py, f32) + "__c" + "_".join(str(v) for v in choices)
     return _load(key, stem, src)
 
