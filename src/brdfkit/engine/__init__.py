@@ -7,7 +7,8 @@ says which one is active (SPEC.md, "Evaluation engine"). Default: ``compiled``.
 * ``compiled`` — the model's scalar kernel, compiled by numba (nopython,
   ``error_model="numpy"``, no fastmath), run by a parallel driver over flat views
   of the direction arrays (chunked ``prange``), float32 or float64 in and out,
-  output allocated once. Kernels are cached on disk (see :mod:`.cache`), so a new
+  output allocated once. float32 input runs the kernel's float32 twin
+  (:mod:`.precision`), compiled with LLVM's ``contract`` flag only (fused multiply-adds). Kernels are cached on disk (see :mod:`.cache`), so a new
   process pays no compile.
 * ``reference`` — THE SAME kernel functions, uncompiled: every numba dispatcher
   the kernel calls is replaced by its original Python function
