@@ -655,26 +655,105 @@ def constant_columns(residuals, packer: "ParamPacker", points: Iterable[np.ndarr
     return out
 
 
-def _jacobian(fn: "_Start", packer: "ParamPacker", const: Mapping[int, np.ndarray]):
+def channel_groups(residuals, packer: "ParamPacker", points: Iterable[np.ndarray],
+                   skip: Iterable[int] = ()) -> list[list[int]]:
+    """Slots whose forward-difference columns one evaluation can give together.
+
+    The residuals are ``(samples, 3)`` values raveled (channel ``c`` is every third entry from
+    ``c``). A slot of an rgb parameter that, perturbed at every one of ``points``, changes the
+    residuals of its own channel only (bit for bit: every other entry stays the same) has a
+    Jacobian column that is zero outside that channel; slots of different channels so have
+    structurally orthogonal columns, and one evaluation with all of them perturbed gives each
+    column exactly as its own evaluation would (Curtis, Powell & Reid, "On the estimation of
+    sparse Jacobian matrices", J. Inst. Maths Applics 13, 1974). A model's R, G and B are
+    computed each from their own channel's parameters (an eta, k, ks, f0 per channel), so an rgb
+    parameter's three slots take one evaluation, not three. Every other slot (scalars, an rgb
+    slot that changes another channel) is a group of its own. ``skip``: slots left out (the
+    :func:`constant_columns`). Returns the groups, every slot in ascending order, at most one
+    slot per channel in a group; costs one evaluation per point and one per probed slot and point.
+    """
+    skip = set(skip)
+    pts = [np.asarray(x, dtype=np.float64) for x in points]
+    base = [residuals(x) for x in pts]
+    by_channel: dict[int, list[int]] = {0: [], 1: [], 2: []}
+    single: list[int] = []
+    for i, s in enumerate(packer.slots):
+        if i in skip:
+            continue
+        local = s.channel is not None and all(r0.size % 3 == 0 for r0 in base)
+        for x, r0 in zip(pts, base):
+            if not local:
+                break
+            y = x.copy()
+            v = s.from_x(float(x[i]))
+            hv = 1e-3 * (s.hi - s.lo)
+            y[i] = s.to_x(v - hv if v + hv > s.hi else v + hv)
+            changed = (residuals(y) != r0).reshape(-1, 3).any(axis=0)
+            local = bool(changed[s.channel]) and int(changed.sum()) == 1
+        if local:
+            by_channel[s.channel].append(i)
+        else:
+            single.append(i)
+    groups = [[i] for i in single]
+    for k in range(max(len(v) for v in by_channel.values())):
+        groups.append(sorted(v[k] for v in by_channel.values() if k < len(v)))
+    return sorted(groups)
+
+
+def _jacobian(fn: "_Start", packer: "ParamPacker", const: Mapping[int, np.ndarray],
+              groups: list[list[int]] | None = None):
     """The residuals' Jacobian in the optimiser's coordinates: forward differences (the step of
     ``scipy.optimize.approx_derivative``'s 2-point scheme, away from a bound) except for the
-    :func:`constant_columns`, which are their fixed ∂r/∂v times dv/dx (v for a log-scale slot)."""
+    :func:`constant_columns`, which are their fixed ∂r/∂v times dv/dx (v for a log-scale slot).
+
+    ``groups`` (:func:`channel_groups`): slots of one channel each whose differences one
+    evaluation gives; each column is still the quotient of the bits it would have by its own
+    evaluation, and the basin-joining test of :class:`_Start` still sees every column's point
+    with its residuals, in the same order. Without ``groups``, one evaluation per column."""
     rel = getattr(packer.cls, "fit_diff_step", None) or float(np.finfo(np.float64).eps) ** 0.5
+    n = len(packer.slots)
+    if groups is None:
+        groups = [[i] for i in range(n) if i not in const]
+    channel = {i: packer.slots[i].channel for g in groups if len(g) > 1 for i in g}
+
+    def step(x: np.ndarray, i: int) -> float:
+        h = rel * max(1.0, abs(float(x[i]))) * (1.0 if x[i] >= 0 else -1.0)
+        if not packer.lb[i] <= x[i] + h <= packer.ub[i]:
+            h = -h
+        return h
 
     def jac(x: np.ndarray) -> np.ndarray:
         r0 = fn.at(x)
         J = np.empty((r0.size, len(x)))
-        for i, s in enumerate(packer.slots):
-            if i in const:
-                J[:, i] = const[i] * (s.from_x(float(x[i])) if s.log else 1.0)
-                continue
-            h = rel * max(1.0, abs(float(x[i]))) * (1.0 if x[i] >= 0 else -1.0)
-            if not packer.lb[i] <= x[i] + h <= packer.ub[i]:
-                h = -h
+        for i in const:
+            s = packer.slots[i]
+            J[:, i] = const[i] * (s.from_x(float(x[i])) if s.log else 1.0)
+        seen = {}  # slot: the residuals at its own point x + h e_i (from its group's evaluation)
+        for g in groups:
             y = x.copy()
-            y[i] += h
-            h = y[i] - x[i]  # the step as represented
-            J[:, i] = (fn(y) - r0) / h
+            for i in g:
+                y[i] += step(x, i)
+            r = fn.evaluate(y)
+            for i in g:
+                h = y[i] - x[i]  # the step as represented
+                if len(g) == 1:
+                    J[:, i] = (r - r0) / h
+                    seen[i] = (y, r)
+                    continue
+                c = channel[i]
+                J[:, i] = 0.0 / h  # the other channels: (r0 - r0) / h, the sign of zero included
+                J[c::3, i] = (r[c::3] - r0[c::3]) / h
+                seen[i] = (None, r)
+        if fn.known:  # the basin test at every column's own point, in column order
+            for i in sorted(seen):
+                y, r = seen[i]
+                if y is None:
+                    c = channel[i]
+                    y = x.copy()
+                    y[i] += step(x, i)
+                    r, rg = r0.copy(), r
+                    r[c::3] = rg[c::3]
+                fn.check(y, r)
         return J
 
     return jac
@@ -706,15 +785,24 @@ class _Start:
         self._last: tuple[np.ndarray, np.ndarray] | None = None
 
     def __call__(self, x: np.ndarray) -> np.ndarray:
+        r = self.evaluate(x)
+        self.check(x, r)
+        return r
+
+    def evaluate(self, x: np.ndarray) -> np.ndarray:
+        """The residuals at ``x``, counted and remembered, without the basin test."""
         r = self.residuals(x)
         self.nfev += 1
         self._last = (np.array(x, dtype=np.float64), r)
+        return r
+
+    def check(self, x: np.ndarray, r: np.ndarray) -> None:
+        """Raise :class:`_Joined` if ``x`` with residuals ``r`` lies in a known minimum's basin."""
         if self.known:
             c = float(r @ r)
             for xk, ck in self.known:
                 if c <= ck * (1 + JOIN_RTOL) and float(np.max(np.abs(x - xk) / self.span)) <= JOIN_XTOL:
                     raise _Joined(np.array(x, dtype=np.float64), c)
-        return r
 
     def at(self, x: np.ndarray) -> np.ndarray:
         """The residuals at ``x``, reusing the last evaluation if it was there."""
@@ -723,12 +811,12 @@ class _Start:
         return self(x)
 
 
-def _local(residuals, x0, packer, max_nfev, tol, known=(), const=None):
+def _local(residuals, x0, packer, max_nfev, tol, known=(), const=None, groups=None):
     """A bounded least-squares run from ``x0``: ``(x, cost = Σ r², evaluations, joined)``.
 
     ``known``: ``(x, cost)`` of minima found by earlier starts; a run that enters one's
     basin (:data:`JOIN_XTOL`, :data:`JOIN_RTOL`) stops there. ``const``: the
-    :func:`constant_columns` of the Jacobian."""
+    :func:`constant_columns` of the Jacobian; ``groups``: its :func:`channel_groups`."""
     from scipy.optimize import least_squares
 
     x0 = np.clip(x0, packer.lb, packer.ub)
@@ -739,7 +827,8 @@ def _local(residuals, x0, packer, max_nfev, tol, known=(), const=None):
     # values can resolve; scipy's default (~1e-8 relative) would see no change at all
     diff_step = getattr(packer.cls, "fit_diff_step", None)
     fn = _Start(residuals, packer, list(known))
-    jac = _jacobian(fn, packer, const) if const else "2-point"
+    grouped = groups is not None and any(len(g) > 1 for g in groups)
+    jac = _jacobian(fn, packer, const or {}, groups if grouped else None) if const or grouped else "2-point"
     try:
         res = least_squares(
             fn, x0, jac=jac, bounds=(packer.lb, packer.ub), method="trf", x_scale="jac", tr_solver="lsmr",
@@ -905,10 +994,13 @@ def fit(
             cand += list(packer.random_x(rng, candidates))
         costs = np.array([cost(x) for x in cand])
         # Jacobian columns known once for all (a float32-evaluated model's differences are too noisy)
-        const = {}
+        const, groups = {}, None
         if not getattr(cls, "fit_diff_step", None):
             const = constant_columns(residuals, packer, cand[:2])
             nfev += min(2, len(cand)) * (len(packer) + 1)
+            groups = channel_groups(residuals, packer, cand[:2], skip=const)
+            nfev += min(2, len(cand)) * (1 + sum(s.channel is not None for i, s in enumerate(packer.slots)
+                                                 if i not in const))
     nfev += len(cand)
     order = [0] + [int(i) for i in np.argsort(costs) if i != 0]
     chosen = order[:starts]
@@ -931,7 +1023,7 @@ def fit(
     try:
         for n_done, ci in enumerate(chosen, 1):
             with _engine_threads(len(search)):
-                x, cst, used, joined = _local(residuals, cand[ci], packer, max_nfev or 100, tol, known, const)
+                x, cst, used, joined = _local(residuals, cand[ci], packer, max_nfev or 100, tol, known, const, groups)
             nfev += used
             start_errors.append(math.sqrt(cst))
             if not joined:
