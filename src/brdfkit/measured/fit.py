@@ -617,9 +617,11 @@ def _residual_fn(packer: "ParamPacker", data: Samples, T, metric: str = "", prep
     return residuals
 
 
-def _value_derivative(residuals, packer: "ParamPacker", x: np.ndarray, i: int, r0: np.ndarray) -> np.ndarray:
+def _value_derivative(residuals, packer: "ParamPacker", x: np.ndarray, i: int, r0: np.ndarray
+                      ) -> tuple[np.ndarray, np.ndarray]:
     """∂r/∂v of slot ``i``'s parameter value v (not its optimiser coordinate) at ``x``, by a forward
-    difference of 10⁻³ of its range (exact for a parameter the residuals are affine in)."""
+    difference of 10⁻³ of its range (exact for a parameter the residuals are affine in), and which
+    of the three channels' residuals the step changed at all (``(3,)`` booleans, bit for bit)."""
     s = packer.slots[i]
     v = s.from_x(float(x[i]))
     hv = 1e-3 * (s.hi - s.lo)
@@ -627,36 +629,61 @@ def _value_derivative(residuals, packer: "ParamPacker", x: np.ndarray, i: int, r
         hv = -hv
     y = x.copy()
     y[i] = s.to_x(v + hv)
-    return (residuals(y) - r0) / hv
+    r = residuals(y)
+    changed = (r != r0).reshape(-1, 3).any(axis=0) if r.size % 3 == 0 else np.ones(3, bool)
+    return (r - r0) / hv, changed
 
 
-def constant_columns(residuals, packer: "ParamPacker", points: Iterable[np.ndarray]) -> dict[int, np.ndarray]:
+@dataclass
+class ColumnProbes:
+    """Every slot's :func:`_value_derivative` at a few points (:func:`probe_columns`)."""
+
+    points: int
+    derivatives: list[list[np.ndarray]]  # per slot, per point probed
+    changed: list[list[np.ndarray]]  # per slot, per point probed: the channels the step changed
+
+
+def probe_columns(residuals, packer: "ParamPacker", points: Iterable[np.ndarray]) -> ColumnProbes:
+    """Each slot's value derivative at each of ``points``, the evidence of :func:`constant_columns`
+    and :func:`channel_groups`; a slot with no effect at the first point is not probed further.
+    Costs one evaluation per point and one per slot and point probed."""
+    pts = [np.asarray(x, dtype=np.float64) for x in points]
+    base = [residuals(x) for x in pts]
+    probes = ColumnProbes(len(pts), [], [])
+    for i in range(len(packer)):
+        ds, chs = [], []
+        for x, r0 in zip(pts, base):
+            d, changed = _value_derivative(residuals, packer, x, i, r0)
+            ds.append(d)
+            chs.append(changed)
+            if not np.any(d):
+                break  # no effect here: neither constant nor of one channel
+        probes.derivatives.append(ds)
+        probes.changed.append(chs)
+    return probes
+
+
+def constant_columns(residuals, packer: "ParamPacker", points: Iterable[np.ndarray],
+                     probes: ColumnProbes | None = None) -> dict[int, np.ndarray]:
     """The slots whose residuals' derivative with respect to the parameter's value is the same at
     every one of ``points``: parameters the model is affine in with a coefficient no other
     parameter changes (a Lambertian ``kd``: ∂f/∂kd = 1/π). Their Jacobian column is known once
     for all (:func:`_jacobian`). Returns ``{slot: ∂r/∂v}``; costs one evaluation per point and
-    one per slot and point."""
-    pts = [np.asarray(x, dtype=np.float64) for x in points]
-    base = [residuals(x) for x in pts]
+    one per slot and point (none with ``probes``, :func:`probe_columns` at those points)."""
+    if probes is None:
+        probes = probe_columns(residuals, packer, points)
     out = {}
-    for i in range(len(packer)):
-        ref = None
-        for x, r0 in zip(pts, base):
-            d = _value_derivative(residuals, packer, x, i, r0)
-            if ref is None:
-                ref = d
-                if not np.any(ref):
-                    break  # no effect here: not known to be constant
-            elif not np.allclose(d, ref, rtol=1e-6, atol=1e-9 * float(np.max(np.abs(ref)))):
-                ref = None
-                break
-        if ref is not None and np.any(ref):
+    for i, ds in enumerate(probes.derivatives):
+        ref = ds[0]
+        if not np.any(ref):
+            continue  # no effect here: not known to be constant
+        if all(np.allclose(d, ref, rtol=1e-6, atol=1e-9 * float(np.max(np.abs(ref)))) for d in ds[1:]):
             out[i] = ref
     return out
 
 
 def channel_groups(residuals, packer: "ParamPacker", points: Iterable[np.ndarray],
-                   skip: Iterable[int] = ()) -> list[list[int]]:
+                   skip: Iterable[int] = (), probes: ColumnProbes | None = None) -> list[list[int]]:
     """Slots whose forward-difference columns one evaluation can give together.
 
     The residuals are ``(samples, 3)`` values raveled (channel ``c`` is every third entry from
@@ -670,27 +697,19 @@ def channel_groups(residuals, packer: "ParamPacker", points: Iterable[np.ndarray
     parameter's three slots take one evaluation, not three. Every other slot (scalars, an rgb
     slot that changes another channel) is a group of its own. ``skip``: slots left out (the
     :func:`constant_columns`). Returns the groups, every slot in ascending order, at most one
-    slot per channel in a group; costs one evaluation per point and one per probed slot and point.
+    slot per channel in a group; costs what :func:`probe_columns` costs (nothing with ``probes``).
     """
+    if probes is None:
+        probes = probe_columns(residuals, packer, points)
     skip = set(skip)
-    pts = [np.asarray(x, dtype=np.float64) for x in points]
-    base = [residuals(x) for x in pts]
     by_channel: dict[int, list[int]] = {0: [], 1: [], 2: []}
     single: list[int] = []
     for i, s in enumerate(packer.slots):
         if i in skip:
             continue
-        local = s.channel is not None and all(r0.size % 3 == 0 for r0 in base)
-        for x, r0 in zip(pts, base):
-            if not local:
-                break
-            y = x.copy()
-            v = s.from_x(float(x[i]))
-            hv = 1e-3 * (s.hi - s.lo)
-            y[i] = s.to_x(v - hv if v + hv > s.hi else v + hv)
-            changed = (residuals(y) != r0).reshape(-1, 3).any(axis=0)
-            local = bool(changed[s.channel]) and int(changed.sum()) == 1
-        if local:
+        chs = probes.changed[i]
+        if s.channel is not None and len(chs) == probes.points and all(
+                bool(ch[s.channel]) and int(ch.sum()) == 1 for ch in chs):
             by_channel[s.channel].append(i)
         else:
             single.append(i)
@@ -698,6 +717,18 @@ def channel_groups(residuals, packer: "ParamPacker", points: Iterable[np.ndarray
     for k in range(max(len(v) for v in by_channel.values())):
         groups.append(sorted(v[k] for v in by_channel.values() if k < len(v)))
     return sorted(groups)
+
+
+def _own_channel(r0: np.ndarray, rg: np.ndarray, c: int) -> Callable[[], np.ndarray]:
+    """The residuals at a grouped column's own point, built when asked: ``r0`` with channel ``c``
+    taken from its group's evaluation ``rg`` (the bits that point's own evaluation gives)."""
+
+    def build() -> np.ndarray:
+        r = r0.copy()
+        r[c::3] = rg[c::3]
+        return r
+
+    return build
 
 
 def _jacobian(fn: "_Start", packer: "ParamPacker", const: Mapping[int, np.ndarray],
@@ -748,11 +779,9 @@ def _jacobian(fn: "_Start", packer: "ParamPacker", const: Mapping[int, np.ndarra
             for i in sorted(seen):
                 y, r = seen[i]
                 if y is None:
-                    c = channel[i]
                     y = x.copy()
                     y[i] += step(x, i)
-                    r, rg = r0.copy(), r
-                    r[c::3] = rg[c::3]
+                    r = _own_channel(r0, r, channel[i])
                 fn.check(y, r)
         return J
 
@@ -796,12 +825,16 @@ class _Start:
         self._last = (np.array(x, dtype=np.float64), r)
         return r
 
-    def check(self, x: np.ndarray, r: np.ndarray) -> None:
-        """Raise :class:`_Joined` if ``x`` with residuals ``r`` lies in a known minimum's basin."""
-        if self.known:
-            c = float(r @ r)
-            for xk, ck in self.known:
-                if c <= ck * (1 + JOIN_RTOL) and float(np.max(np.abs(x - xk) / self.span)) <= JOIN_XTOL:
+    def check(self, x: np.ndarray, r: np.ndarray | Callable[[], np.ndarray]) -> None:
+        """Raise :class:`_Joined` if ``x`` with residuals ``r`` (or ``r()``, called only if needed)
+        lies in a known minimum's basin."""
+        c = None
+        for xk, ck in self.known:
+            if float(np.max(np.abs(x - xk) / self.span)) <= JOIN_XTOL:
+                if c is None:
+                    rv = r() if callable(r) else r
+                    c = float(rv @ rv)
+                if c <= ck * (1 + JOIN_RTOL):
                     raise _Joined(np.array(x, dtype=np.float64), c)
 
     def at(self, x: np.ndarray) -> np.ndarray:
@@ -996,11 +1029,10 @@ def fit(
         # Jacobian columns known once for all (a float32-evaluated model's differences are too noisy)
         const, groups = {}, None
         if not getattr(cls, "fit_diff_step", None):
-            const = constant_columns(residuals, packer, cand[:2])
+            probes = probe_columns(residuals, packer, cand[:2])
             nfev += min(2, len(cand)) * (len(packer) + 1)
-            groups = channel_groups(residuals, packer, cand[:2], skip=const)
-            nfev += min(2, len(cand)) * (1 + sum(s.channel is not None for i, s in enumerate(packer.slots)
-                                                 if i not in const))
+            const = constant_columns(residuals, packer, cand[:2], probes)
+            groups = channel_groups(residuals, packer, cand[:2], const, probes)
     nfev += len(cand)
     order = [0] + [int(i) for i in np.argsort(costs) if i != 0]
     chosen = order[:starts]
