@@ -42,7 +42,9 @@ minimum an earlier start converged to (within :data:`JOIN_XTOL` of it in every
 free value, :data:`JOIN_RTOL` in cost) stops there; its ``start_errors`` entry is
 the error it had then. The Jacobian is by forward differences, except for the
 columns of parameters the residuals are affine in with a constant coefficient
-(a Lambertian ``kd``), found by probing (:func:`constant_columns`) and reused.
+(a Lambertian ``kd``), found by probing (:func:`constant_columns`) and reused; the
+slots of an rgb parameter whose residuals are those of their own channel only (found
+by the same probes, :func:`channel_groups`) take one evaluation for their three columns.
 """
 
 from __future__ import annotations
