@@ -255,3 +255,66 @@ def test_starts_joining_a_known_basin_stop_early_and_lose_nothing(monkeypatch):
     # a joined start stopped within JOIN_RTOL (in cost) of the best minimum
     best = min(joined.start_errors)
     assert sum(e <= best * (1 + F.JOIN_RTOL) ** 0.5 for e in joined.start_errors) >= 2
+
+
+@pytest.mark.parametrize("name, fixed", [("microfacet", {}), ("microfacet", {"distribution": "ggx", "fresnel": "schlick"}),
+                                         ("cook-torrance", {}), ("ashikhmin-shirley", {}), ("ward", {})])
+def test_channel_grouped_jacobian_is_the_columnwise_one_bit_for_bit(name, fixed):
+    packer, res, pts, rng = _probe(name, fixed)
+    const = F.constant_columns(res, packer, pts)
+    groups = F.channel_groups(res, packer, pts, skip=const)
+    assert sorted(i for g in groups for i in g) == [i for i in range(len(packer)) if i not in const]
+    assert any(len(g) > 1 for g in groups)  # every rgb parameter here is computed per channel
+    for g in groups:
+        chans = [packer.slots[i].channel for i in g]
+        assert len(g) == 1 or (None not in chans and len(set(chans)) == len(g))
+    for x in packer.random_x(rng, 3):
+        one = F._Start(res, packer, [])
+        J = F._jacobian(one, packer, const)(x)
+        grouped = F._Start(res, packer, [])
+        Jg = F._jacobian(grouped, packer, const, groups)(x)
+        assert J.tobytes() == Jg.tobytes()
+        assert grouped.nfev == len(groups) + 1 < one.nfev
+
+
+def test_channel_groups_keep_a_slot_that_changes_other_channels_alone():
+    packer, res, pts, _ = _probe("microfacet", {"distribution": "ggx", "fresnel": "schlick"})
+    mixed = [i for i, s in enumerate(packer.slots) if s.param.name == "f0"][1]
+
+    def coupled(x):  # channel 0 also depends on f0[1]
+        r = res(x).copy()
+        r[0::3] *= 1 + x[mixed]
+        return r
+
+    groups = F.channel_groups(coupled, packer, pts)
+    assert [mixed] in groups
+    assert all(len(g) == 1 or mixed not in g for g in groups)
+
+
+def test_grouped_jacobian_joins_a_basin_at_the_same_column_point():
+    packer, res, pts, rng = _probe("microfacet", {"distribution": "ggx", "fresnel": "schlick"})
+    const = F.constant_columns(res, packer, pts)
+    groups = F.channel_groups(res, packer, pts, skip=const)
+    x = packer.random_x(rng, 1)[0]
+    seen = []
+
+    class Spy(F._Start):  # records the points and costs the basin test sees, in order
+        def check(self, y, r):
+            seen.append((y.tobytes(), float(r @ r)))
+
+    spy = Spy(res, packer, [(x.copy(), 0.0)])
+    spy.evaluate(x)  # the Jacobian's base point: not a column's
+    F._jacobian(spy, packer, const)(x)
+    assert len(seen) == len(packer) - len(const)
+    joined = set()
+    for t in sorted(c for _, c in seen):  # a basin each column's point (with those of lower cost) joins
+        ck = t / (1 + F.JOIN_RTOL) * (1 + 1e-12)
+        first = next(yc for yc in seen if yc[1] <= ck * (1 + F.JOIN_RTOL))
+        for g in (None, groups):
+            fn = F._Start(res, packer, [(x.copy(), ck)])
+            fn.evaluate(x)
+            with pytest.raises(F._Joined) as e:
+                F._jacobian(fn, packer, const, g)(x)
+            assert (e.value.x.tobytes(), e.value.cost) == first
+        joined.add(first[0])
+    assert len(joined) >= 2  # not always the first column

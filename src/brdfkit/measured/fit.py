@@ -42,7 +42,9 @@ minimum an earlier start converged to (within :data:`JOIN_XTOL` of it in every
 free value, :data:`JOIN_RTOL` in cost) stops there; its ``start_errors`` entry is
 the error it had then. The Jacobian is by forward differences, except for the
 columns of parameters the residuals are affine in with a constant coefficient
-(a Lambertian ``kd``), found by probing (:func:`constant_columns`) and reused.
+(a Lambertian ``kd``), found by probing (:func:`constant_columns`) and reused; the
+slots of an rgb parameter whose residuals are those of their own channel only (found
+by the same probes, :func:`channel_groups`) take one evaluation for their three columns.
 """
 
 from __future__ import annotations
@@ -617,9 +619,11 @@ def _residual_fn(packer: "ParamPacker", data: Samples, T, metric: str = "", prep
     return residuals
 
 
-def _value_derivative(residuals, packer: "ParamPacker", x: np.ndarray, i: int, r0: np.ndarray) -> np.ndarray:
+def _value_derivative(residuals, packer: "ParamPacker", x: np.ndarray, i: int, r0: np.ndarray
+                      ) -> tuple[np.ndarray, np.ndarray]:
     """∂r/∂v of slot ``i``'s parameter value v (not its optimiser coordinate) at ``x``, by a forward
-    difference of 10⁻³ of its range (exact for a parameter the residuals are affine in)."""
+    difference of 10⁻³ of its range (exact for a parameter the residuals are affine in), and which
+    of the three channels' residuals the step changed at all (``(3,)`` booleans, bit for bit)."""
     s = packer.slots[i]
     v = s.from_x(float(x[i]))
     hv = 1e-3 * (s.hi - s.lo)
@@ -627,54 +631,160 @@ def _value_derivative(residuals, packer: "ParamPacker", x: np.ndarray, i: int, r
         hv = -hv
     y = x.copy()
     y[i] = s.to_x(v + hv)
-    return (residuals(y) - r0) / hv
+    r = residuals(y)
+    changed = (r != r0).reshape(-1, 3).any(axis=0) if r.size % 3 == 0 else np.ones(3, bool)
+    return (r - r0) / hv, changed
 
 
-def constant_columns(residuals, packer: "ParamPacker", points: Iterable[np.ndarray]) -> dict[int, np.ndarray]:
+@dataclass
+class ColumnProbes:
+    """Every slot's :func:`_value_derivative` at a few points (:func:`probe_columns`)."""
+
+    points: int
+    derivatives: list[list[np.ndarray]]  # per slot, per point probed
+    changed: list[list[np.ndarray]]  # per slot, per point probed: the channels the step changed
+
+
+def probe_columns(residuals, packer: "ParamPacker", points: Iterable[np.ndarray]) -> ColumnProbes:
+    """Each slot's value derivative at each of ``points``, the evidence of :func:`constant_columns`
+    and :func:`channel_groups`; a slot with no effect at the first point is not probed further.
+    Costs one evaluation per point and one per slot and point probed."""
+    pts = [np.asarray(x, dtype=np.float64) for x in points]
+    base = [residuals(x) for x in pts]
+    probes = ColumnProbes(len(pts), [], [])
+    for i in range(len(packer)):
+        ds, chs = [], []
+        for x, r0 in zip(pts, base):
+            d, changed = _value_derivative(residuals, packer, x, i, r0)
+            ds.append(d)
+            chs.append(changed)
+            if not np.any(d):
+                break  # no effect here: neither constant nor of one channel
+        probes.derivatives.append(ds)
+        probes.changed.append(chs)
+    return probes
+
+
+def constant_columns(residuals, packer: "ParamPacker", points: Iterable[np.ndarray],
+                     probes: ColumnProbes | None = None) -> dict[int, np.ndarray]:
     """The slots whose residuals' derivative with respect to the parameter's value is the same at
     every one of ``points``: parameters the model is affine in with a coefficient no other
     parameter changes (a Lambertian ``kd``: ∂f/∂kd = 1/π). Their Jacobian column is known once
     for all (:func:`_jacobian`). Returns ``{slot: ∂r/∂v}``; costs one evaluation per point and
-    one per slot and point."""
-    pts = [np.asarray(x, dtype=np.float64) for x in points]
-    base = [residuals(x) for x in pts]
+    one per slot and point (none with ``probes``, :func:`probe_columns` at those points)."""
+    if probes is None:
+        probes = probe_columns(residuals, packer, points)
     out = {}
-    for i in range(len(packer)):
-        ref = None
-        for x, r0 in zip(pts, base):
-            d = _value_derivative(residuals, packer, x, i, r0)
-            if ref is None:
-                ref = d
-                if not np.any(ref):
-                    break  # no effect here: not known to be constant
-            elif not np.allclose(d, ref, rtol=1e-6, atol=1e-9 * float(np.max(np.abs(ref)))):
-                ref = None
-                break
-        if ref is not None and np.any(ref):
+    for i, ds in enumerate(probes.derivatives):
+        ref = ds[0]
+        if not np.any(ref):
+            continue  # no effect here: not known to be constant
+        if all(np.allclose(d, ref, rtol=1e-6, atol=1e-9 * float(np.max(np.abs(ref)))) for d in ds[1:]):
             out[i] = ref
     return out
 
 
-def _jacobian(fn: "_Start", packer: "ParamPacker", const: Mapping[int, np.ndarray]):
+def channel_groups(residuals, packer: "ParamPacker", points: Iterable[np.ndarray],
+                   skip: Iterable[int] = (), probes: ColumnProbes | None = None) -> list[list[int]]:
+    """Slots whose forward-difference columns one evaluation can give together.
+
+    The residuals are ``(samples, 3)`` values raveled (channel ``c`` is every third entry from
+    ``c``). A slot of an rgb parameter that, perturbed at every one of ``points``, changes the
+    residuals of its own channel only (bit for bit: every other entry stays the same) has a
+    Jacobian column that is zero outside that channel; slots of different channels so have
+    structurally orthogonal columns, and one evaluation with all of them perturbed gives each
+    column exactly as its own evaluation would (Curtis, Powell & Reid, "On the estimation of
+    sparse Jacobian matrices", J. Inst. Maths Applics 13, 1974). A model's R, G and B are
+    computed each from their own channel's parameters (an eta, k, ks, f0 per channel), so an rgb
+    parameter's three slots take one evaluation, not three. Every other slot (scalars, an rgb
+    slot that changes another channel) is a group of its own. ``skip``: slots left out (the
+    :func:`constant_columns`). Returns the groups, every slot in ascending order, at most one
+    slot per channel in a group; costs what :func:`probe_columns` costs (nothing with ``probes``).
+    """
+    if probes is None:
+        probes = probe_columns(residuals, packer, points)
+    skip = set(skip)
+    by_channel: dict[int, list[int]] = {0: [], 1: [], 2: []}
+    single: list[int] = []
+    for i, s in enumerate(packer.slots):
+        if i in skip:
+            continue
+        chs = probes.changed[i]
+        if s.channel is not None and len(chs) == probes.points and all(
+                bool(ch[s.channel]) and int(ch.sum()) == 1 for ch in chs):
+            by_channel[s.channel].append(i)
+        else:
+            single.append(i)
+    groups = [[i] for i in single]
+    for k in range(max(len(v) for v in by_channel.values())):
+        groups.append(sorted(v[k] for v in by_channel.values() if k < len(v)))
+    return sorted(groups)
+
+
+def _own_channel(r0: np.ndarray, rg: np.ndarray, c: int) -> Callable[[], np.ndarray]:
+    """The residuals at a grouped column's own point, built when asked: ``r0`` with channel ``c``
+    taken from its group's evaluation ``rg`` (the bits that point's own evaluation gives)."""
+
+    def build() -> np.ndarray:
+        r = r0.copy()
+        r[c::3] = rg[c::3]
+        return r
+
+    return build
+
+
+def _jacobian(fn: "_Start", packer: "ParamPacker", const: Mapping[int, np.ndarray],
+              groups: list[list[int]] | None = None):
     """The residuals' Jacobian in the optimiser's coordinates: forward differences (the step of
     ``scipy.optimize.approx_derivative``'s 2-point scheme, away from a bound) except for the
-    :func:`constant_columns`, which are their fixed ∂r/∂v times dv/dx (v for a log-scale slot)."""
+    :func:`constant_columns`, which are their fixed ∂r/∂v times dv/dx (v for a log-scale slot).
+
+    ``groups`` (:func:`channel_groups`): slots of one channel each whose differences one
+    evaluation gives; each column is still the quotient of the bits it would have by its own
+    evaluation, and the basin-joining test of :class:`_Start` still sees every column's point
+    with its residuals, in the same order. Without ``groups``, one evaluation per column."""
     rel = getattr(packer.cls, "fit_diff_step", None) or float(np.finfo(np.float64).eps) ** 0.5
+    n = len(packer.slots)
+    if groups is None:
+        groups = [[i] for i in range(n) if i not in const]
+    channel = {i: packer.slots[i].channel for g in groups if len(g) > 1 for i in g}
+
+    def step(x: np.ndarray, i: int) -> float:
+        h = rel * max(1.0, abs(float(x[i]))) * (1.0 if x[i] >= 0 else -1.0)
+        if not packer.lb[i] <= x[i] + h <= packer.ub[i]:
+            h = -h
+        return h
 
     def jac(x: np.ndarray) -> np.ndarray:
         r0 = fn.at(x)
         J = np.empty((r0.size, len(x)))
-        for i, s in enumerate(packer.slots):
-            if i in const:
-                J[:, i] = const[i] * (s.from_x(float(x[i])) if s.log else 1.0)
-                continue
-            h = rel * max(1.0, abs(float(x[i]))) * (1.0 if x[i] >= 0 else -1.0)
-            if not packer.lb[i] <= x[i] + h <= packer.ub[i]:
-                h = -h
+        for i in const:
+            s = packer.slots[i]
+            J[:, i] = const[i] * (s.from_x(float(x[i])) if s.log else 1.0)
+        seen = {}  # slot: the residuals at its own point x + h e_i (from its group's evaluation)
+        for g in groups:
             y = x.copy()
-            y[i] += h
-            h = y[i] - x[i]  # the step as represented
-            J[:, i] = (fn(y) - r0) / h
+            for i in g:
+                y[i] += step(x, i)
+            r = fn.evaluate(y)
+            for i in g:
+                h = y[i] - x[i]  # the step as represented
+                if len(g) == 1:
+                    J[:, i] = (r - r0) / h
+                    seen[i] = (y, r)
+                    continue
+                c = channel[i]
+                J[:, i] = 0.0 / h  # the other channels: (r0 - r0) / h, the sign of zero included
+                J[c::3, i] = (r[c::3] - r0[c::3]) / h
+                seen[i] = (None, r)
+        if fn.known:  # the basin test at every column's own point, in column order
+            for i in sorted(seen):
+                y, r = seen[i]
+                if y is None:
+                    y = x.copy()
+                    y[i] += step(x, i)
+                    r = _own_channel(r0, r, channel[i])
+                fn.check(y, r)
         return J
 
     return jac
@@ -706,15 +816,28 @@ class _Start:
         self._last: tuple[np.ndarray, np.ndarray] | None = None
 
     def __call__(self, x: np.ndarray) -> np.ndarray:
+        r = self.evaluate(x)
+        self.check(x, r)
+        return r
+
+    def evaluate(self, x: np.ndarray) -> np.ndarray:
+        """The residuals at ``x``, counted and remembered, without the basin test."""
         r = self.residuals(x)
         self.nfev += 1
         self._last = (np.array(x, dtype=np.float64), r)
-        if self.known:
-            c = float(r @ r)
-            for xk, ck in self.known:
-                if c <= ck * (1 + JOIN_RTOL) and float(np.max(np.abs(x - xk) / self.span)) <= JOIN_XTOL:
-                    raise _Joined(np.array(x, dtype=np.float64), c)
         return r
+
+    def check(self, x: np.ndarray, r: np.ndarray | Callable[[], np.ndarray]) -> None:
+        """Raise :class:`_Joined` if ``x`` with residuals ``r`` (or ``r()``, called only if needed)
+        lies in a known minimum's basin."""
+        c = None
+        for xk, ck in self.known:
+            if float(np.max(np.abs(x - xk) / self.span)) <= JOIN_XTOL:
+                if c is None:
+                    rv = r() if callable(r) else r
+                    c = float(rv @ rv)
+                if c <= ck * (1 + JOIN_RTOL):
+                    raise _Joined(np.array(x, dtype=np.float64), c)
 
     def at(self, x: np.ndarray) -> np.ndarray:
         """The residuals at ``x``, reusing the last evaluation if it was there."""
@@ -723,12 +846,12 @@ class _Start:
         return self(x)
 
 
-def _local(residuals, x0, packer, max_nfev, tol, known=(), const=None):
+def _local(residuals, x0, packer, max_nfev, tol, known=(), const=None, groups=None):
     """A bounded least-squares run from ``x0``: ``(x, cost = Σ r², evaluations, joined)``.
 
     ``known``: ``(x, cost)`` of minima found by earlier starts; a run that enters one's
     basin (:data:`JOIN_XTOL`, :data:`JOIN_RTOL`) stops there. ``const``: the
-    :func:`constant_columns` of the Jacobian."""
+    :func:`constant_columns` of the Jacobian; ``groups``: its :func:`channel_groups`."""
     from scipy.optimize import least_squares
 
     x0 = np.clip(x0, packer.lb, packer.ub)
@@ -739,7 +862,8 @@ def _local(residuals, x0, packer, max_nfev, tol, known=(), const=None):
     # values can resolve; scipy's default (~1e-8 relative) would see no change at all
     diff_step = getattr(packer.cls, "fit_diff_step", None)
     fn = _Start(residuals, packer, list(known))
-    jac = _jacobian(fn, packer, const) if const else "2-point"
+    grouped = groups is not None and any(len(g) > 1 for g in groups)
+    jac = _jacobian(fn, packer, const or {}, groups if grouped else None) if const or grouped else "2-point"
     try:
         res = least_squares(
             fn, x0, jac=jac, bounds=(packer.lb, packer.ub), method="trf", x_scale="jac", tr_solver="lsmr",
@@ -905,10 +1029,12 @@ def fit(
             cand += list(packer.random_x(rng, candidates))
         costs = np.array([cost(x) for x in cand])
         # Jacobian columns known once for all (a float32-evaluated model's differences are too noisy)
-        const = {}
+        const, groups = {}, None
         if not getattr(cls, "fit_diff_step", None):
-            const = constant_columns(residuals, packer, cand[:2])
+            probes = probe_columns(residuals, packer, cand[:2])
             nfev += min(2, len(cand)) * (len(packer) + 1)
+            const = constant_columns(residuals, packer, cand[:2], probes)
+            groups = channel_groups(residuals, packer, cand[:2], const, probes)
     nfev += len(cand)
     order = [0] + [int(i) for i in np.argsort(costs) if i != 0]
     chosen = order[:starts]
@@ -931,7 +1057,7 @@ def fit(
     try:
         for n_done, ci in enumerate(chosen, 1):
             with _engine_threads(len(search)):
-                x, cst, used, joined = _local(residuals, cand[ci], packer, max_nfev or 100, tol, known, const)
+                x, cst, used, joined = _local(residuals, cand[ci], packer, max_nfev or 100, tol, known, const, groups)
             nfev += used
             start_errors.append(math.sqrt(cst))
             if not joined:
