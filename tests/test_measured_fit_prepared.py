@@ -73,6 +73,7 @@ def test_unvalidated_model_equals_the_validated_one(name):
     for x in [packer.lb, packer.ub, *packer.random_x(rng, 4)]:
         fast, ref = ev.model(x), packer.model(x)
         assert type(fast) is type(ref) and list(fast.params) == list(ref.params)
+        assert fast.isotropic == ref.isotropic and list(fast.active_params()) == list(ref.active_params())
         for k, v in ref.params.items():
             assert np.array_equal(fast.params[k], v), k
             if isinstance(v, np.ndarray):
@@ -81,6 +82,25 @@ def test_unvalidated_model_equals_the_validated_one(name):
             pf, cf = fast.kernel_args()
             pr, cr = ref.kernel_args()
             assert np.array_equal(pf, pr) and np.array_equal(cf, cr)
+
+
+def test_microfacet_skips_revalidation_and_a_subclass_does_not_inherit_that():
+    """microfacet declares from_valid_is_init beside its __init__ (it only resolves the alpha aliases),
+    so the fitter builds it unvalidated; a subclass with an __init__ of its own is validated again."""
+    cls = registry.get("microfacet")
+    data = F.sample("merl/gold-metallic-paint", n=64, seed=1)
+    assert F._PreparedEval(F.ParamPacker(cls), data).unvalidated
+
+    class Sub(cls):
+        def __init__(self, **params):
+            super().__init__(**params)
+
+    assert not F._PreparedEval(F.ParamPacker(Sub), data).unvalidated
+    ani = F.ParamPacker(cls, tie_isotropic=False)
+    ev = F._PreparedEval(ani, data)
+    x = ani.x_of(dict(ani.fixed, alpha_x=0.1, alpha_y=0.4))
+    fast, ref = ev.model(x), ani.model(x)
+    assert fast.params["alpha"] is None and ref.params["alpha"] is None and not fast.isotropic
 
 
 def test_a_value_outside_the_spec_raises_the_spec_error():

@@ -541,8 +541,9 @@ class _PreparedEval:
     and fixed values were validated when it was built, and a free value is used only if it
     lies within its slot's ``[lo, hi]``, which :func:`_bounds` keeps inside the spec's range
     (open ends moved inwards); anything else (NaN, say) goes through ``packer.model(x)``,
-    which raises the spec's error. A class with its own ``__init__`` (``microfacet``: the
-    roughness aliases) is always built by ``packer.model(x)``, validated. Models without a
+    which raises the spec's error. A class with its own ``__init__`` is always built by
+    ``packer.model(x)``, validated, unless it declares ``from_valid_is_init`` beside it
+    (``microfacet``, whose ``__init__`` only resolves the roughness aliases). Models without a
     kernel, or whose ``kernel_args()`` is ``None``, are evaluated by ``BRDF.eval`` as before.
     The returned array is overwritten by the next call."""
 
@@ -552,7 +553,9 @@ class _PreparedEval:
         self.packer, self.data = packer, data
         cls = packer.cls
         self.kernel = getattr(cls, "kernel", None)
-        self.unvalidated = cls.__init__ is BRDF.__init__  # _from_valid equals __init__ only then
+        # _from_valid equals __init__ only for BRDF's own __init__ or a class that declares it (microfacet)
+        self.unvalidated = cls.__init__ is BRDF.__init__ or (
+            "__init__" in vars(cls) and vars(cls).get("from_valid_is_init", False))
         self.fi, self.fo, shape, dtype = prepare(cls.name, data.wi, data.wo)
         if self.kernel is not None:
             check_unit_flat(cls.name, self.fi, self.fo, dtype)

@@ -48,7 +48,9 @@ class BRDF:
         """The model of ``params`` already in the form ``validate`` returns (every value checked, in
         the spec's order, rgb values read-only arrays), without checking them again: for a hot loop
         that keeps its values inside the spec (the fitter's prepared evaluation). A class whose
-        ``__init__`` does more than validate must not be built this way."""
+        ``__init__`` does more than validate must not be built this way, unless it declares
+        ``from_valid_is_init = True`` beside that ``__init__`` (its ``__init__`` only prepares the
+        values for validation and its ``_init_valid`` derives the rest: microfacet)."""
         m = object.__new__(cls)
         m._init_valid(params)
         return m

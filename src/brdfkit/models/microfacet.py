@@ -229,12 +229,19 @@ class Microfacet(BRDF):
                   "Fresnel-weighted; brdfkit.terms.multiscatter)"),
     )
 
+    #: ``_from_valid`` builds the same object as ``__init__`` from validated values: ``__init__`` only
+    #: resolves the alpha aliases before validating, and ``_init_valid`` derives the rest
+    from_valid_is_init = True
+
     def __init__(self, **params: Any) -> None:
         by_name = {p.name: p for p in self.spec}
         super().__init__(**resolve_roughness(self.name, params, by_name))
-        ax, ay = self.params["alpha_x"], self.params["alpha_y"]
-        self.params["alpha"] = ax if ax == ay else None
+
+    def _init_valid(self, params: dict[str, Any]) -> None:
+        ax, ay = params["alpha_x"], params["alpha_y"]
+        params["alpha"] = ax if ax == ay else None
         self.isotropic = ax == ay  # per instance; the class (info) says "can be anisotropic"
+        super()._init_valid(params)
 
     def active_params(self) -> dict[str, Any]:
         """``params`` less what the options switch off: eta/k/f0 by Fresnel, alpha vs alpha_x/alpha_y."""
