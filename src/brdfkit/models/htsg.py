@@ -355,24 +355,20 @@ def direct_log_ratio(g, T):
     lo = max(math.floor(mstar - WINDOW_LEFT[0] * sig - WINDOW_LEFT[1]), 1.0)
     hi = math.ceil(mstar + WINDOW_RIGHT[0] * sig + WINDOW_RIGHT[1])
     mc = min(max(math.floor(mstar + 0.5), lo), hi)
-    lc = ln_fact_times_m(mc)
-    tc = T / mc
-    peak = (mc - 1.0) * lg - g - lc - tc  # log_term(mc, lg, g, T)
+    peak = log_term(mc, lg, g, T)
     h = thinning_step(var, -g - T - peak)  # log_term(1) = −g − T
     jlo = -math.floor((mc - lo) / h)
     jhi = math.floor((hi - mc) / h)
-    c0 = lc + tc
-    hlg = h * lg
     acc = 0.0
     if mc + jhi * h < LN_TABLE_SIZE:
         k0 = int(mc)
         ih = int(h)
-        for j in range(int(jlo), int(jhi) + 1):  # ln t_m − ln t_mc, m = mc + j h, from the table
-            acc += math.exp(j * hlg - _LN_FACT_M[k0 + j * ih] + c0 - T / (mc + j * h))
+        for j in range(int(jlo), int(jhi) + 1):  # log_term(m) − peak, ln(m!·m) read from the table (no branch)
+            m = mc + j * h
+            acc += math.exp((m - 1.0) * lg - g - _LN_FACT_M[k0 + j * ih] - T / m - peak)
     else:
         for j in range(int(jlo), int(jhi) + 1):
-            m = mc + j * h
-            acc += math.exp(j * hlg - ln_fact_times_m(m) + c0 - T / m)
+            acc += math.exp(log_term(mc + j * h, lg, g, T) - peak)
     return peak + math.log(h * acc)
 
 
