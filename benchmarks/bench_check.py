@@ -2,7 +2,8 @@
 
     .venv/bin/python benchmarks/bench_check.py [--quick]
 
-Prints wall-clock seconds and the load average before each run. The target (issue 9) is
+Prints wall-clock seconds, the CPU seconds of the run (user + system, all its processes; less
+disturbed by other load on a shared machine than the wall clock) and the load average before each run. The target (issue 9) is
 `check --all --json --jobs 2` under 3 s wall with a warm numba cache; each `check --all`
 configuration runs twice, so that the second run is warm. `--quick` skips the single-worker run
 and the per-model timings.
@@ -11,6 +12,7 @@ and the per-model timings.
 from __future__ import annotations
 
 import os
+import resource
 import subprocess
 import sys
 import time
@@ -46,10 +48,13 @@ def main() -> None:
         for _ in range(2):
             load = os.getloadavg()[0]
             t = time.perf_counter()
+            r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
             p = subprocess.run(cmd + ["check", "--all", "--json", "--jobs", str(jobs)], capture_output=True, text=True)
             dt = time.perf_counter() - t
+            r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+            cpu = (r1.ru_utime - r0.ru_utime) + (r1.ru_stime - r0.ru_stime)
             status = "ok" if p.returncode == 0 else f"exit {p.returncode}: {p.stderr.strip()[:80]}"
-            print(f"  --jobs {jobs}: {dt:6.2f} s wall  (load {load:.2f} before; {status})")
+            print(f"  --jobs {jobs}: {dt:6.2f} s wall, {cpu:5.2f} s CPU  (load {load:.2f} before; {status})")
 
 
 if __name__ == "__main__":

@@ -259,3 +259,20 @@ def test_mirror_test_rejects_a_chiral_model_and_fold_rejects_an_asymmetric_rule(
     assert half is not None and half[0].shape[0] < 0.6 * wi.shape[0]
     assert abs(half[1].sum() - w.sum()) <= 1e-12 * w.sum()
     assert _fold(*half_vector_rule(0.7, 0.3, 5, 32)) is None  # wo off the plane y = 0
+
+
+def test_check_all_tasks_cover_every_setting_once_and_keep_models_together():
+    from brdfkit.analysis import verdict
+
+    work = verdict.stress_jobs()
+    tasks = verdict.check_tasks(work)
+    flat = [i for t in tasks for i in t]
+    assert sorted(flat) == list(range(len(work)))
+    n_expensive = sum(n in verdict.EXPENSIVE_MODELS for n, _ in work)
+    assert n_expensive >= 2
+    # the expensive model's settings first, one task each; then one task per other model
+    assert all(len(t) == 1 and work[t[0]][0] in verdict.EXPENSIVE_MODELS for t in tasks[:n_expensive])
+    rest = tasks[n_expensive:]
+    names = [{work[i][0] for i in t} for t in rest]
+    assert all(len(s) == 1 for s in names) and len({next(iter(s)) for s in names}) == len(rest)
+    assert [len(t) for t in rest] == sorted((len(t) for t in rest), reverse=True)

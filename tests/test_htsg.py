@@ -71,6 +71,24 @@ def test_series_matches_long_sum_over_documented_range():
     assert rel.max() < 1e-6, (gs[ok][rel.argmax()], Ts[ok][rel.argmax()], rel.max())
 
 
+def test_thinned_direct_sum_matches_long_sum():
+    # the direct tier alone where it takes every h-th term (h > 1: wide peaks), and near the
+    # thinning's switch (the m = 1 term about e^-30 of the peak, g ≈ 30-45): Poisson summation's
+    # bound is ~2e-13; without the m = 1 condition the error is ~4e-5 at g ≈ 14
+    rng = np.random.default_rng(7)
+    g = np.concatenate([10 ** rng.uniform(1, 4.3, 300), rng.uniform(10, 50, 300)])
+    T = np.where(rng.random(600) < 0.2, 0.0, g * 10 ** rng.uniform(-4, 1.5, 600))
+    lw = np.where(T > 0, H.lambertw_from_log(np.log(np.maximum(2 * T, 1e-300)) - 2 * np.log(g)), 0.0)
+    mstar = np.maximum(g * np.exp(0.5 * lw), 1.0)
+    var = 1 / (1 / mstar + 2 * T / mstar**3)
+    steps = np.array([H.thinning_step(v, -40.0) for v in var])
+    assert (steps > 1).mean() > 0.5 and steps.max() > 20  # the test exercises the thinning
+    got = H._direct_log_ratio(g, T)
+    ref = np.array([_long_sum_log_ratio(a, b) for a, b in zip(g, T)])
+    rel = np.abs(np.expm1(got - ref))
+    assert rel.max() < 1e-8, (g[rel.argmax()], T[rel.argmax()], rel.max())
+
+
 @pytest.mark.parametrize(
     "g,T",
     [(1e-3, 0.0), (0.3, 2.0), (1.0, 0.0), (4.2, 17.0), (12.0, 300.0), (25.0, 1.0), (39.0, 80.0),

@@ -278,12 +278,39 @@ def _check_setting(name: str, setting: dict[str, Any], level: str) -> dict[str, 
     return r
 
 
+#: models whose settings ``check --all`` gives a worker each (their kernels dominate the run); the
+#: settings of every other model go to one worker together, so that each model's compiled kernel is
+#: loaded from the numba cache by one process only
+EXPENSIVE_MODELS = ("htsg",)
+
+
+def _check_group(items: list[tuple[str, dict[str, Any]]], level: str) -> list[dict[str, Any]]:
+    """:func:`_check_setting` of each ``(name, setting)`` in turn (one task of the ``check --all`` pool)."""
+    return [_check_setting(n, s, level) for n, s in items]
+
+
+def check_tasks(work: list[tuple[str, dict[str, Any]]]) -> list[list[int]]:
+    """The pool's tasks, as lists of indices into ``work``, in submission order.
+
+    One task per setting of an :data:`EXPENSIVE_MODELS` model, submitted first (longest first, so
+    that the workers finish together); then one task per other model with all its settings (a
+    worker loads that model's kernel once instead of every worker loading it).
+    """
+    expensive = [[i] for i, (n, _) in enumerate(work) if n in EXPENSIVE_MODELS]
+    groups: dict[str, list[int]] = {}
+    for i, (n, _) in enumerate(work):
+        if n not in EXPENSIVE_MODELS:
+            groups.setdefault(n, []).append(i)
+    return expensive + sorted(groups.values(), key=len, reverse=True)
+
+
 def run_checks(
     work: list[tuple[str, dict[str, Any]]], *, level: str = "fast", jobs: int = 1, progress=None
 ) -> list[dict[str, Any]]:
     """:func:`check` every ``(name, setting)`` of ``work`` (in ``jobs`` processes); results in ``work`` order.
 
-    ``progress(name, setting, result)`` is called as each one finishes.
+    ``progress(name, setting, result)`` is called as each one finishes (with ``jobs > 1``: as
+    each task of :func:`check_tasks` finishes).
     """
     results: list[Any] = [None] * len(work)
 
@@ -298,11 +325,10 @@ def run_checks(
 
         ctx = mp.get_context("fork") if "fork" in mp.get_all_start_methods() else None
         with cf.ProcessPoolExecutor(max_workers=jobs, mp_context=ctx) as ex:
-            # the expensive model (htsg) first, so that the workers finish together
-            order = sorted(range(len(work)), key=lambda i: work[i][0] != "htsg")
-            futs = {ex.submit(_check_setting, work[i][0], work[i][1], level): i for i in order}
+            futs = {ex.submit(_check_group, [work[i] for i in task], level): task for task in check_tasks(work)}
             for f in cf.as_completed(futs):
-                done(futs[f], f.result())
+                for i, r in zip(futs[f], f.result()):
+                    done(i, r)
     else:
         for i, (n, s) in enumerate(work):
             done(i, _check_setting(n, s, level))
@@ -321,4 +347,4 @@ def check_all(
     return run_checks(stress_jobs(names), level=level, jobs=jobs, progress=progress)
 
 
-__all__ = ["check", "check_all", "mirror_symmetric", "run_checks", "stress_jobs", "stress_settings", "STRESS", "DEFAULT_THETA_DEG"]
+__all__ = ["check", "check_all", "check_tasks", "mirror_symmetric", "run_checks", "stress_jobs", "stress_settings", "STRESS", "DEFAULT_THETA_DEG"]

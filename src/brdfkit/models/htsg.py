@@ -97,11 +97,23 @@ tiers:
   saddle point ``m* = g·exp(W(2T/g²)/2)`` (the root of ln(m/g) = T/m²; for
   T = 0 it is the Poisson mean g, in the tail it moves to larger m) and its
   width ``σ_m = (1/m* + 2T/m*³)^(−1/2)``. **Truncation:** the sum runs over
-  ``m ∈ [m* − 6σ_m − 1, m* + 7σ_m + 4] ∩ [1, ∞)``; the terms left out are
-  below 1e-10 of the sum (measured against the full sum: ≤ 5e-11). The terms
-  are accumulated relative to the one at round(m*) with the exact ratio of
-  consecutive terms, ``t_m/t_(m−1) = g(m−1)/m² · exp(T/(m(m−1)))``, so nothing
-  overflows; a few dozen terms for the paper's examples.
+  ``m ∈ [m* − 6σ_m, m* + 7σ_m + 3] ∩ [1, ∞)``; the terms left out are
+  below 1e-9 of the sum (measured against the same sum over a window twice as wide, at 20000
+  random (g, T): ≤ 7.8e-10, the same as with the previous, two terms wider window; the GLSL
+  twin keeps that one). Each term is
+  computed directly relative to the one at m_c = round(m*),
+  ``exp((m − m_c) ln g − [ln(m!·m) − ln(m_c!·m_c)] − T/m + T/m_c)``, with ln(m!·m) from a
+  table built at import (m < 8192; lgamma above), so nothing overflows and the loop over m is
+  a reduction of independent terms. **Thinning:** where the peak is wide, only every h-th
+  term is taken and the sum multiplied by h. By Poisson summation, ``h Σ_j t(a + jh)``
+  differs from ``Σ_m t(m)`` by the summand's lattice characteristic function at ν = k/h,
+  k = 1..h−1; for a Poisson(g) summand that is ``exp(−g(1 − cos 2πk/h))``. The step is the
+  largest h with ``σ_m² (1 − cos(2π/h)) ≥ 30`` (bound 2e^(−30) ≈ 2e-13 in the Poisson case),
+  and h = 1 wherever the m = 1 term exceeds e^(−30) of the peak (the summand is cut off
+  there, and the 1/m factor's pole at m = 0 then leaves a slowly decaying remainder of order
+  g ln g e^(−g)). Measured against the long sum at 6000 random (g, T), 1e-4 ≤ g ≤ 2e4:
+  ≤ 1.3e-9 (the long sum's own rounding at g > 1e3 is of that order). About 13σ_m/h + 3 terms:
+  a few dozen for g < 30, ~16 for wide peaks whatever g.
 * **Asymptotic form** (g ≥ 40 and ``a = T/g ≤ 0.5·g^0.55``, i.e. large g,
   in and around the lobe): writing ``e^(−T/m)/m`` as a Laplace transform,
   ``Σ = ∫₀^∞ J0(2√(Tt)) (e^(−g(1−e^(−t))) − e^(−g)) dt``; expanding about
@@ -172,8 +184,8 @@ ASYMPTOTIC_ORDER = 6
 ASYMPTOTIC_A_SCALE = 0.5
 ASYMPTOTIC_A_POWER = 0.55
 #: window of the direct sum, in units of the peak width σ_m, left and right of the saddle point
-WINDOW_LEFT = (6.0, 1.0)  # m* − 6 σ_m − 1
-WINDOW_RIGHT = (7.0, 4.0)  # m* + 7 σ_m + 4
+WINDOW_LEFT = (6.0, 0.0)  # m* − 6 σ_m
+WINDOW_RIGHT = (7.0, 3.0)  # m* + 7 σ_m + 3
 
 _SQRT_PI = math.sqrt(math.pi)
 _TINY = 1e-300
@@ -288,13 +300,41 @@ def asymptotic_log_ratio(g, T):
 # ---------------------------------------------------------------------------
 # The directional-diffuse series
 # ---------------------------------------------------------------------------
-_MAX_RATIO_EXP = 600.0  # larger term-ratio exponents go to the log-space path
+#: ln(m!·m) is tabulated for m below this (the direct sum's terms need no lgamma there)
+LN_TABLE_SIZE = 8192
+_LN_FACT_M = np.array([0.0] + [math.lgamma(m + 1.0) + math.log(m) for m in range(1, LN_TABLE_SIZE)])
+#: the direct sum takes every h-th term where ``var·(1 − cos(2π/h)) ≥ THIN_MARGIN`` (module docstring)
+THIN_MARGIN = 30.0
+#: Newton iterations of W for the saddle point (the window's position: m* to 5e-5 relative)
+SADDLE_W_ITERATIONS = 2.0
+
+
+@jit
+def ln_fact_times_m(m):
+    """``ln(m!·m)`` for an integer-valued m ≥ 1: the module table below LN_TABLE_SIZE, lgamma above."""
+    if m < LN_TABLE_SIZE:
+        return _LN_FACT_M[int(m)]
+    return math.lgamma(m + 1.0) + math.log(m)
 
 
 @jit
 def log_term(m, lg, g, T):
-    """ln of the m-th term of Σ/g: (m−1) ln g − g − ln Γ(m+1) − ln m − T/m (real m ≥ 1)."""
-    return (m - 1.0) * lg - g - math.lgamma(m + 1.0) - math.log(m) - T / m
+    """ln of the m-th term of Σ/g: (m−1) ln g − g − ln(m!·m) − T/m (integer-valued m ≥ 1)."""
+    return (m - 1.0) * lg - g - ln_fact_times_m(m) - T / m
+
+
+@jit
+def thinning_step(var, edge):
+    """The step h of the direct sum: the largest integer with ``var·(1 − cos(2π/h)) ≥ THIN_MARGIN``.
+
+    ``var`` is the summand's variance σ_m², ``edge`` the log of its m = 1 term relative to the
+    peak's. h = 1 (every term) unless the summand is negligible at m = 1 (``edge < −THIN_MARGIN``):
+    cut off there, it is not a smooth peak and the lattice argument of the module docstring
+    does not hold.
+    """
+    if edge > -THIN_MARGIN or 2.0 * var <= THIN_MARGIN:
+        return 1.0
+    return max(math.floor(2.0 * math.pi / math.acos(1.0 - THIN_MARGIN / var)), 1.0)
 
 
 @jit
@@ -302,45 +342,34 @@ def direct_log_ratio(g, T):
     """ln(Σ/g) by the windowed direct sum (g > 0, T ≥ 0).
 
     The window ``[lo, hi]`` surrounds the saddle point m* = g exp(W(2T/g²)/2) (width
-    σ_m = (1/m* + 2T/m*³)^(−1/2)); the terms are accumulated relative to the term at
-    ``m_c = round(m*)``, walking right to ``hi`` and left to ``lo`` with the exact ratio of
-    consecutive terms ``t_m/t_(m−1) = g (m−1)/m² · exp(T/(m(m−1)))``, so nothing overflows
-    or underflows near the peak. Where the first ratio's exponent passes 600 the sum is
-    taken in log space instead.
+    σ_m = (1/m* + 2T/m*³)^(−1/2)). Every h-th term (:func:`thinning_step`) is taken, each
+    directly relative to the term at ``m_c = round(m*)``, ``exp(ln t_m − ln t_(m_c))``, with
+    ln(m!·m) from the module table: the iterations are independent (a reduction), and
+    nothing overflows or underflows near the peak.
     """
     lg = math.log(g)
-    w = lambertw_log(math.log(2.0 * T) - 2.0 * lg, 3.0) if T > 0.0 else 0.0
+    w = lambertw_log(math.log(2.0 * T) - 2.0 * lg, SADDLE_W_ITERATIONS) if T > 0.0 else 0.0
     mstar = max(g * math.exp(0.5 * w), 1.0)
-    sig = 1.0 / math.sqrt(1.0 / mstar + 2.0 * T / (mstar * mstar * mstar))
+    var = 1.0 / (1.0 / mstar + 2.0 * T / (mstar * mstar * mstar))
+    sig = math.sqrt(var)
     lo = max(math.floor(mstar - WINDOW_LEFT[0] * sig - WINDOW_LEFT[1]), 1.0)
     hi = math.ceil(mstar + WINDOW_RIGHT[0] * sig + WINDOW_RIGHT[1])
     mc = min(max(math.floor(mstar + 0.5), lo), hi)
-    if T / (mc * (mc + 1.0)) > _MAX_RATIO_EXP:
-        mx = -math.inf
-        m = lo
-        while m <= hi:
-            mx = max(mx, log_term(m, lg, g, T))
-            m += 1.0
-        acc = 0.0
-        m = lo
-        while m <= hi:
-            acc += math.exp(log_term(m, lg, g, T) - mx)
-            m += 1.0
-        return mx + math.log(acc)
-    acc = 1.0
-    t = 1.0
-    m = mc + 1.0
-    while m <= hi:  # right: t_m = t_(m−1) · g (m−1)/m² · exp(T/(m(m−1)))
-        t *= g * (m - 1.0) / (m * m) * math.exp(T / (m * (m - 1.0)))
-        acc += t
-        m += 1.0
-    t = 1.0
-    m = mc
-    while m > lo:  # left: t_(m−1) = t_m · m²/(g (m−1)) · exp(−T/(m(m−1)))
-        t *= m * m / (g * (m - 1.0)) * math.exp(-T / (m * (m - 1.0)))
-        acc += t
-        m -= 1.0
-    return log_term(mc, lg, g, T) + math.log(acc)
+    peak = log_term(mc, lg, g, T)
+    h = thinning_step(var, -g - T - peak)  # log_term(1) = −g − T
+    jlo = -math.floor((mc - lo) / h)
+    jhi = math.floor((hi - mc) / h)
+    acc = 0.0
+    if mc + jhi * h < LN_TABLE_SIZE:
+        k0 = int(mc)
+        ih = int(h)
+        for j in range(int(jlo), int(jhi) + 1):  # log_term(m) − peak, ln(m!·m) read from the table (no branch)
+            m = mc + j * h
+            acc += math.exp((m - 1.0) * lg - g - _LN_FACT_M[k0 + j * ih] - T / m - peak)
+    else:
+        for j in range(int(jlo), int(jhi) + 1):
+            acc += math.exp(log_term(mc + j * h, lg, g, T) - peak)
+    return peak + math.log(h * acc)
 
 
 @jit
