@@ -126,10 +126,11 @@ tiers:
   (Q_n has degree n+1; the coefficients are derived exactly with rationals at
   import, :func:`asymptotic_coefficients`, ``ASYMPTOTIC_ORDER = 6``). The
   leading term is Beckmann's rough-surface limit. Its relative error in its
-  region is below 1e-7 (largest just above g = 40: 9.8e-8 near g ≈ 43, found by an
-  independent comparison), falling fast with g.
+  region is at most 1.6e-7, at its lower corner (g = 40, T ≈ 152; 1.2e-7 at g = 41.5,
+  9.8e-8 near g ≈ 43; checked against mpmath in ``tests/test_reliability_docs.py``),
+  falling fast with g.
 
-**Accuracy** (tests): relative error ≤ 1e-6 (measured: ≤ 1e-7, 9.8e-8 near g ≈ 43) against a long
+**Accuracy** (tests): relative error ≤ 1e-6 (measured: ≤ 1.6e-7, at g = 40) against a long
 log-space sum over every m and against 40-digit mpmath sums, for
 1e-4 ≤ g ≤ 1e5 and any T ≥ 0 (tested where Σ/g ≥ 1e-300; ``ln(Σ/g)`` stays
 accurate below that, only the value itself underflows to 0 far outside the lobe). These g cover the whole
