@@ -350,3 +350,40 @@ def test_unexpected_exception_is_one_line_unless_debug(capsys, monkeypatch):
     monkeypatch.setenv("BRDFKIT_DEBUG", "1")
     with pytest.raises(RuntimeError, match="no GL driver"):
         main(["eval", "lambert", "--wi", "0,0", "--wo", "0,0"])
+
+
+def test_the_command_table_names_what_each_plugin_registers():
+    """cli.COMMANDS (which plugin a run imports for its command) matches what the plugins register."""
+    import importlib
+
+    import typer
+
+    from brdfkit import cli
+
+    found = {}
+    for mod in cli._PLUGINS:
+        sub = typer.Typer()
+        importlib.import_module(mod).register(sub)
+        for c in sub.registered_commands:
+            found[c.name or c.callback.__name__] = mod
+    assert found == cli.COMMANDS
+
+
+def test_a_command_imports_only_its_own_plugin_and_help_lists_all(capsys):
+    code = (
+        "import sys\n"
+        "from brdfkit.cli import main\n"
+        "rc = main(['eval', 'lambert', '--wi', '10,0', '--wo', '20,90'])\n"
+        "print(rc, sorted(m for m in sys.modules if m.startswith(('brdfkit.render', 'brdfkit.web', "
+        "'brdfkit.measured.commands', 'brdfkit.analysis.commands', 'brdfkit.interchange'))))\n"
+    )
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert r.stdout.strip().splitlines()[-1] == "0 []", r.stdout
+    from brdfkit import cli
+
+    rc, out, _ = run_cli(capsys, "--help")
+    assert rc == 0
+    for name in cli.COMMANDS:
+        assert name in out, name
+    rc, _, err = run_cli(capsys, "evl")  # a misspelt command: every plugin loaded, click's one-line error
+    assert rc == 2 and "No such command" in err

@@ -1,8 +1,8 @@
 """The ``brdfkit`` command line (typer + rich).
 
-Core commands (``list``, ``info``, ``eval``) live here; each area adds its own
-commands through a ``register(app)`` function in the module listed in
-``_PLUGINS``. :func:`main` turns every error (usage errors, ``ValueError`` /
+Core commands (``list``, ``info``, ``eval``) live in :mod:`brdfkit.cli_core`; each
+area adds its own commands through a ``register(app)`` function in the module listed in
+``_PLUGINS``, imported only when a command of it runs (:func:`load_commands`). :func:`main` turns every error (usage errors, ``ValueError`` /
 ``OSError`` for bad input, and anything unexpected) into one line on stderr and
 a non-zero exit — never a traceback (``BRDFKIT_DEBUG=1`` shows the traceback of
 an unexpected error).
@@ -53,8 +53,36 @@ _PLUGINS: tuple[str, ...] = (
     "brdfkit.interchange.commands",
 )
 
-for _mod in _PLUGINS:
-    importlib.import_module(_mod).register(app)
+#: each command's plugin, so that a run imports only the plugin of the command it runs (``brdfkit
+#: eval`` then skips the renderer, the web server and their imports: ~0.1 s of a ~1 s start);
+#: ``tests/test_cli_core.py`` checks this table against what every plugin registers
+COMMANDS: dict[str, str] = {
+    "list": "brdfkit.cli_core",
+    "info": "brdfkit.cli_core",
+    "eval": "brdfkit.cli_core",
+    "check": "brdfkit.analysis.commands",
+    "plot": "brdfkit.analysis.commands",
+    "fit": "brdfkit.measured.commands",
+    "render": "brdfkit.render.commands",
+    "gallery": "brdfkit.render.commands",
+    "serve": "brdfkit.web.commands",
+    "export": "brdfkit.interchange.commands",
+}
+_REGISTERED: set[str] = set()
+
+
+def load_commands(argv: list[str] | None = None) -> typer.Typer:
+    """Register the plugin of the command named in ``argv`` (default ``sys.argv[1:]``) on :data:`app`,
+    or every plugin when there is none or it is not in :data:`COMMANDS` (``--help``, ``--version``,
+    a misspelt name: the full list then appears in the help or the error). Returns :data:`app`."""
+    args = sys.argv[1:] if argv is None else list(argv)
+    name = next((a for a in args if not a.startswith("-")), None)
+    wanted = (COMMANDS[name],) if name in COMMANDS else _PLUGINS
+    for mod in wanted:
+        if mod not in _REGISTERED:
+            importlib.import_module(mod).register(app)
+            _REGISTERED.add(mod)
+    return app
 
 
 def _one_line(exc: BaseException) -> str:
@@ -80,6 +108,7 @@ def main(argv: list[str] | None = None) -> int:
     status 1; set ``BRDFKIT_DEBUG=1`` to get the traceback instead.
     """
     try:
+        load_commands(argv)
         rv = app(args=argv, prog_name="brdfkit", standalone_mode=False)
     except SystemExit as e:
         code = e.code
