@@ -6,6 +6,7 @@ import os
 import subprocess
 import sys
 
+import numba
 import numpy as np
 import pytest
 
@@ -319,3 +320,40 @@ def test_forced_width_compile_hides_llvm_remarks_only():
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert "remark:" not in out.stderr
     assert out.stderr.splitlines() == ["a real warning", "after"]
+
+
+@pytest.mark.parametrize("name", ["microfacet", "htsg"])
+@pytest.mark.parametrize("dtype", [np.float64, np.float32])
+def test_specialised_driver_runs_serially_or_in_parallel_with_the_same_bits(name, dtype, monkeypatch):
+    """A call whose estimated work is below PARALLEL_MIN_S runs the serial twin of the specialised driver
+    (no thread-pool launch); both give the same values bit for bit, and the same unit-length error."""
+    import math
+
+    m = bk.model(name)
+    n = 3 * driver.CHUNK + 17
+    wi, wo = _pairs(n, seed=3, dtype=dtype)
+    p, c = m.kernel_args()
+    f32 = dtype == np.float32 and type(m).kernel_float32
+    py = type(m).kernel.py_func
+    key = (py.__module__, py.__name__, f32, tuple(int(v) for v in c))
+    m.eval(wi, wo)  # loads (or compiles) the drivers; the estimate of the work starts with the next call
+    calls = []
+    serial = driver._SERIAL[key]
+    monkeypatch.setitem(driver._SERIAL, key, lambda *a: (calls.append(1), serial(*a))[1])
+    if numba.get_num_threads() > 1:
+        monkeypatch.setattr(driver, "PARALLEL_MIN_S", 0.0)
+        par = m.eval(wi, wo)
+        assert calls == []  # in parallel
+    else:  # one thread: always serial
+        par = m.eval(wi, wo)
+        calls.clear()
+    assert key in driver._PAIR_COST and driver._PAIR_COST[key] > 0
+    monkeypatch.setattr(driver, "PARALLEL_MIN_S", math.inf)
+    ser = m.eval(wi, wo)
+    assert calls == [1]
+    assert ser.dtype == par.dtype == dtype and np.array_equal(ser, par)
+    bad = wi.copy()
+    bad[n - 5] *= 1.01
+    with pytest.raises(ValueError, match="wi must be unit"):
+        m.eval(bad, wo)
+    assert calls == [1, 1]

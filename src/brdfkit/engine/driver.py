@@ -21,7 +21,10 @@ Calls of more than :data:`CHUNK` pairs run instead a driver generated per kernel
 choice combination (:data:`SPECIAL_TEMPLATE`, lazily, cached on disk): choices as a
 constant tuple, the kernel inlined, ``p`` as a tuple, a branch-free loop over flat
 views, and the unit check as a vectorisable count of pairs outside a safe band (exact
-statistics only when that count is not zero). LLVM vectorises that loop where the
+statistics only when that count is not zero). Its chunks run in parallel, or serially on
+the calling thread (``drive_serial``, the same loop) when numba has one thread or the call's
+work, estimated from the driver's earlier calls, is below :data:`PARALLEL_MIN_S`: a parallel
+launch costs more than a fitter's evaluation of 3000 samples. LLVM vectorises that loop where the
 kernel calls no libm function (issue 9; README, "Speed"). Kernels whose ``p`` holds a
 table (longer than :data:`MAX_TUPLE`) keep the generic driver.
 """
@@ -36,6 +39,7 @@ import re
 import sys
 import tempfile
 import threading
+import time
 from collections import Counter
 from typing import Callable
 
@@ -162,9 +166,28 @@ def drive(wi, wo, p, out, lim, lo2, hi2, nrm):
     for ch in numba.prange(nchunks):
         lo = ch * CHUNK
         span(wi, wo, p, out, lim, lo2, hi2, nrm, ch, lo, min(n, lo + CHUNK))
+
+
+@numba.njit(cache=True, error_model="numpy", nogil=True, fastmath={FM})
+def drive_serial(wi, wo, p, out, lim, lo2, hi2, nrm):
+    # the same chunks on the calling thread: no thread-pool launch (~0.1-0.2 ms on workqueue)
+    n = wi.shape[0] // 3
+    nchunks = (n + CHUNK - 1) // CHUNK
+    for ch in range(nchunks):
+        lo = ch * CHUNK
+        span(wi, wo, p, out, lim, lo2, hi2, nrm, ch, lo, min(n, lo + CHUNK))
 """
 
 _DRIVERS: dict[tuple, Callable] = {}
+#: the serial twin (``drive_serial``) of each specialised driver, by the same key
+_SERIAL: dict[tuple, Callable] = {}
+#: a call whose work, estimated from the driver's earlier calls, is below this many seconds on one
+#: thread runs serially. Measured here (2 cores, load 0.5), serial / parallel: GGX microfacet 3000
+#: pairs 0.14 / 0.38 ms, 48 000 pairs 1.3 / 1.7 ms, 96 000 pairs 2.4 / 2.2 ms; Lambert 96 000 pairs
+#: 0.44 / 0.59 ms; HTSG 3000 pairs 4.6 / 3.1 ms: a launch on numba's workqueue layer costs ~0.2-0.5 ms
+PARALLEL_MIN_S = 2e-3
+#: seconds per pair on one thread, measured on each driver's calls after its first (by key)
+_PAIR_COST: dict[tuple, float] = {}
 _LOCK = threading.Lock()
 #: one parallel launch at a time (numba's workqueue layer is not reentrant across threads)
 _RUN_LOCK = threading.Lock()
@@ -248,6 +271,8 @@ def _load(key: tuple, stem: str, src: str) -> Callable:
         with in_cache_dir():
             spec.loader.exec_module(mod)
         sys.modules[modname] = mod
+        if hasattr(mod, "drive_serial"):
+            _SERIAL[key] = mod.drive_serial
         _DRIVERS[key] = mod.drive
         return mod.drive
 
@@ -369,7 +394,14 @@ def run(kernel: Callable, wi: np.ndarray, wo: np.ndarray, p: np.ndarray, c: np.n
         return nrm
     from .evaluate import UNIT_TOL
 
-    drive = special_driver_for(kernel, tuple(int(v) for v in c), f32)
+    choices = tuple(int(v) for v in c)
+    drive = special_driver_for(kernel, choices, f32)
+    key = (getattr(kernel, "py_func", kernel).__module__, getattr(kernel, "py_func", kernel).__name__, f32, choices)
+    threads = numba.get_num_threads()
+    cost = _PAIR_COST.get(key)
+    serial = threads == 1 or (cost is not None and n * cost < PARALLEL_MIN_S)
+    if serial:
+        drive = _SERIAL[key]
     tol = UNIT_TOL[out.dtype]
     # a band of squared lengths safely inside |w| in [1 - tol, 1 + tol]: the margin is far above the
     # rounding of x² + y² + z² in the working precision (and of the band's own rounding to it)
@@ -378,11 +410,15 @@ def run(kernel: Callable, wi: np.ndarray, wo: np.ndarray, p: np.ndarray, c: np.n
     hi2 = ft((1.0 + tol) * (1.0 + tol) * (1.0 - margin))
     bad = np.zeros(nrm.shape[0], dtype=np.int64)
     pt = param_tuple(p, ft)
-    first = f32 and (drive, len(pt)) not in _COMPILED  # this call may compile (or load) the driver
-    with _RUN_LOCK, (_vector_width(F32_VECTOR_WIDTH) if first else contextlib.nullcontext()):
+    first = (drive, len(pt)) not in _COMPILED  # this call may compile (or load) the driver
+    with _RUN_LOCK, (_vector_width(F32_VECTOR_WIDTH) if f32 and first else contextlib.nullcontext()):
+        t0 = time.perf_counter()
         drive(wi.reshape(-1), wo.reshape(-1), pt, out.reshape(-1), lim, lo2, hi2, bad)
+        elapsed = time.perf_counter() - t0
     if first:
         _COMPILED.add((drive, len(pt)))
+    else:  # one-thread seconds per pair (a parallel call's time times its threads, an upper bound)
+        _PAIR_COST[key] = elapsed * (1 if serial else threads) / n
     if not bad.any():
         nrm[:] = [1.0, 1.0, 0.0, 1.0, 1.0, 0.0]  # every length within tolerance
     else:  # exact statistics (same formula as the generic driver), for check_unit and its message
@@ -390,4 +426,4 @@ def run(kernel: Callable, wi: np.ndarray, wo: np.ndarray, p: np.ndarray, c: np.n
     return nrm
 
 
-__all__ = ["CHUNK", "TEMPLATE", "SPECIAL_TEMPLATE", "driver_for", "special_driver_for", "param_tuple", "run", "nchunks"]
+__all__ = ["CHUNK", "PARALLEL_MIN_S", "TEMPLATE", "SPECIAL_TEMPLATE", "driver_for", "special_driver_for", "param_tuple", "run", "nchunks"]
