@@ -170,7 +170,7 @@ def drive(wi, wo, p, out, lim, lo2, hi2, nrm):
 
 @numba.njit(cache=True, error_model="numpy", nogil=True, fastmath={FM})
 def drive_serial(wi, wo, p, out, lim, lo2, hi2, nrm):
-    # the same chunks on the calling thread: no thread-pool launch (~0.1-0.2 ms on workqueue)
+    # the same chunks on the calling thread: no thread-pool launch (0.2-0.5 ms on workqueue)
     n = wi.shape[0] // 3
     nchunks = (n + CHUNK - 1) // CHUNK
     for ch in range(nchunks):
@@ -336,10 +336,16 @@ def driver_for(kernel: Callable, f32: bool = False) -> KernelDriver:
     return kd
 
 
+def _special_key(kernel: Callable, choices: tuple[int, ...], f32: bool) -> tuple:
+    """The key of a specialised driver (and of its serial twin and work estimate)."""
+    py = getattr(kernel, "py_func", kernel)
+    return (py.__module__, py.__name__, f32, choices)
+
+
 def special_driver_for(kernel: Callable, choices: tuple[int, ...], f32: bool = False) -> Callable:
     """The ``drive`` of ``kernel`` compiled for one combination of choice values (generated lazily, cached on disk)."""
     py = getattr(kernel, "py_func", kernel)
-    key = (py.__module__, py.__name__, f32, choices)
+    key = _special_key(kernel, choices, f32)
     d = _DRIVERS.get(key)
     if d is not None:
         return d
@@ -366,7 +372,9 @@ def run(kernel: Callable, wi: np.ndarray, wo: np.ndarray, p: np.ndarray, c: np.n
 
     Up to :data:`CHUNK` pairs: the generic driver (choices read at run time; one compile per
     kernel and dtype). More: the driver specialised for this choice combination, compiled on
-    first use and cached on disk, whose loop LLVM vectorises. ``f32`` (float32 arrays only):
+    first use and cached on disk, whose loop LLVM vectorises: in parallel, or on the calling thread
+    (its serial twin, without the launch lock) when numba has one thread or the work estimated from
+    the driver's earlier calls is below :data:`PARALLEL_MIN_S`. ``f32`` (float32 arrays only):
     run the kernel's float32 twin, ``p`` rounded to float32 — unless a parameter does not fit
     float32 (:func:`.precision.fits_float32`), then the float64 kernel runs.
     """
@@ -396,7 +404,7 @@ def run(kernel: Callable, wi: np.ndarray, wo: np.ndarray, p: np.ndarray, c: np.n
 
     choices = tuple(int(v) for v in c)
     drive = special_driver_for(kernel, choices, f32)
-    key = (getattr(kernel, "py_func", kernel).__module__, getattr(kernel, "py_func", kernel).__name__, f32, choices)
+    key = _special_key(kernel, choices, f32)
     threads = numba.get_num_threads()
     cost = _PAIR_COST.get(key)
     serial = threads == 1 or (cost is not None and n * cost < PARALLEL_MIN_S)
@@ -411,7 +419,8 @@ def run(kernel: Callable, wi: np.ndarray, wo: np.ndarray, p: np.ndarray, c: np.n
     bad = np.zeros(nrm.shape[0], dtype=np.int64)
     pt = param_tuple(p, ft)
     first = (drive, len(pt)) not in _COMPILED  # this call may compile (or load) the driver
-    with _RUN_LOCK, (_vector_width(F32_VECTOR_WIDTH) if f32 and first else contextlib.nullcontext()):
+    lock = contextlib.nullcontext() if serial else _RUN_LOCK  # a serial call launches no thread pool
+    with lock, (_vector_width(F32_VECTOR_WIDTH) if f32 and first else contextlib.nullcontext()):
         t0 = time.perf_counter()
         drive(wi.reshape(-1), wo.reshape(-1), pt, out.reshape(-1), lim, lo2, hi2, bad)
         elapsed = time.perf_counter() - t0
