@@ -647,6 +647,11 @@ class ColumnProbes:
     derivatives: list[list[np.ndarray]]  # per slot, per point probed
     changed: list[list[np.ndarray]]  # per slot, per point probed: the channels the step changed
 
+    @property
+    def evaluations(self) -> int:
+        """Residual evaluations the probes took: one per point, one per slot and point probed."""
+        return self.points + sum(len(ds) for ds in self.derivatives)
+
 
 def probe_columns(residuals, packer: "ParamPacker", points: Iterable[np.ndarray]) -> ColumnProbes:
     """Each slot's value derivative at each of ``points``, the evidence of :func:`constant_columns`
@@ -779,15 +784,12 @@ def _jacobian(fn: "_Start", packer: "ParamPacker", const: Mapping[int, np.ndarra
                 c = channel[i]
                 J[:, i] = 0.0 / h  # the other channels: (r0 - r0) / h, the sign of zero included
                 J[c::3, i] = (r[c::3] - r0[c::3]) / h
-                seen[i] = (None, r)
+                own = x.copy()
+                own[i] = y[i]  # the column's own point x + h e_i
+                seen[i] = (own, _own_channel(r0, r, c))
         if fn.known:  # the basin test at every column's own point, in column order
             for i in sorted(seen):
-                y, r = seen[i]
-                if y is None:
-                    y = x.copy()
-                    y[i] += step(x, i)
-                    r = _own_channel(r0, r, channel[i])
-                fn.check(y, r)
+                fn.check(*seen[i])
         return J
 
     return jac
@@ -1035,7 +1037,7 @@ def fit(
         const, groups = {}, None
         if not getattr(cls, "fit_diff_step", None):
             probes = probe_columns(residuals, packer, cand[:2])
-            nfev += min(2, len(cand)) * (len(packer) + 1)
+            nfev += probes.evaluations
             const = constant_columns(residuals, packer, cand[:2], probes)
             groups = channel_groups(residuals, packer, cand[:2], const, probes)
     nfev += len(cand)
