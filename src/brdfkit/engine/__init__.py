@@ -5,9 +5,11 @@
 says which one is active (SPEC.md, "Evaluation engine"). Default: ``compiled``.
 
 * ``compiled`` — the model's scalar kernel, compiled by numba (nopython,
-  ``error_model="numpy"``, no fastmath), run by a parallel driver over flat views
-  of the direction arrays (chunked ``prange``), float32 or float64 in and out,
-  output allocated once. float32 input runs the kernel's float32 twin
+  ``error_model="numpy"``, no fastmath but HTSG's series sum, see :func:`jit`), run by a
+  parallel driver over flat views of the direction arrays (chunked ``prange``), float32
+  or float64 in and out, output allocated once. Where the driver's loop vectorises, its
+  math functions (exp, erfc, pow, atan2, ...) are glibc's libmvec vector functions
+  (:mod:`.vecmath`; write kernels without branches around them, so that they do). float32 input runs the kernel's float32 twin
   (:mod:`.precision`), compiled with LLVM's ``contract`` flag only (fused multiply-adds). Kernels are cached on disk (see :mod:`.cache`), so a new
   process pays no compile.
 * ``reference`` — THE SAME kernel functions, uncompiled: every numba dispatcher

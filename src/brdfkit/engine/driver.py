@@ -49,6 +49,7 @@ import numpy as np
 from ..fileio import write_text
 from .cache import cache_dir, in_cache_dir, jit
 from .evaluate import _sq_stats  # the exact length statistics, shared with the generic check
+from . import vecmath
 
 CHUNK = 2048
 #: the specialised driver passes ``p`` as a tuple; kernels with longer ``p`` (tables) keep the generic one
@@ -278,7 +279,9 @@ def _load(key: tuple, stem: str, src: str) -> Callable:
 
 
 def _stem(py, f32: bool = False) -> str:
-    return "drv_" + re.sub(r"[^A-Za-z0-9_]", "_", f"{py.__module__}_{py.__name__}") + ("__f32" if f32 else "")
+    # drivers that call libmvec (.vecmath) have their own files: a process without it never loads one
+    return ("drv_" + re.sub(r"[^A-Za-z0-9_]", "_", f"{py.__module__}_{py.__name__}") + ("__f32" if f32 else "")
+            + ("__vm" if vecmath.available() else ""))
 
 
 #: how a generated driver gets its kernel: the source itself (float64), or its float32 twin
@@ -394,11 +397,14 @@ def run(kernel: Callable, wi: np.ndarray, wo: np.ndarray, p: np.ndarray, c: np.n
     if f32:
         p = p.astype(np.float32)
     if n <= CHUNK:  # a single chunk runs inline, no thread pool: no lock needed
-        driver_for(kernel, f32)._drive(wi, wo, p, c, out, lim, nrm)
+        gd = driver_for(kernel, f32)._drive
+        with vecmath.compiling():  # a compile meanwhile calls libmvec (.vecmath)
+            gd(wi, wo, p, c, out, lim, nrm)
         return nrm
     if len(p) > MAX_TUPLE:  # a table in p (measured data): the generic driver, p stays an array
-        with _RUN_LOCK:
-            driver_for(kernel, f32)._drive(wi, wo, p, c, out, lim, nrm)
+        gd = driver_for(kernel, f32)._drive
+        with _RUN_LOCK, vecmath.compiling():
+            gd(wi, wo, p, c, out, lim, nrm)
         return nrm
     from .evaluate import UNIT_TOL
 
@@ -420,7 +426,8 @@ def run(kernel: Callable, wi: np.ndarray, wo: np.ndarray, p: np.ndarray, c: np.n
     pt = param_tuple(p, ft)
     first = (drive, len(pt)) not in _COMPILED  # this call may compile (or load) the driver
     lock = contextlib.nullcontext() if serial else _RUN_LOCK  # a serial call launches no thread pool
-    with lock, (_vector_width(F32_VECTOR_WIDTH) if f32 and first else contextlib.nullcontext()):
+    with lock, (_vector_width(F32_VECTOR_WIDTH) if f32 and first else contextlib.nullcontext()), \
+            vecmath.compiling():
         t0 = time.perf_counter()
         drive(wi.reshape(-1), wo.reshape(-1), pt, out.reshape(-1), lim, lo2, hi2, bad)
         elapsed = time.perf_counter() - t0
