@@ -365,3 +365,23 @@ def test_ggx_smith_separable_from_parts_is_the_product_of_g1():
             got = sh.g_smith_separable_parts(*dist.lambda_ggx_parts(*a, ax, ay), *dist.lambda_ggx_parts(*b, ax, ay))
             assert 0.0 <= got <= 1.0
             assert abs(got - want) <= 1e-15 * max(want, 1e-300) or (want < 1e-290 and got < 1e-290), (a, b, got, want)
+
+
+def test_dielectric_array_form_is_silent_and_equals_the_scalar_source():
+    """The branch-free f_dielectric vectorises with every square root argument >= 0 in every lane:
+    no invalid-operation flag, so numpy raises no RuntimeWarning for a broadcast grid (it did when
+    a discarded lane took sqrt(n² − 1) for n < 1)."""
+    import warnings
+
+    from brdfkit.terms import fresnel as fr
+
+    c = np.linspace(0.0, 1.0, 1001)[:, None]
+    n = np.array([0.143119, 0.374957, 0.9999, 1.0, 1.0001, 1.442479, 3.0])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with np.errstate(all="raise"):
+            f = fr.fresnel_dielectric_cook(c, n)
+    want = np.array([[fr.f_dielectric.py_func(float(a), float(b)) for b in n] for a in c[:, 0]])
+    np.testing.assert_array_equal(f, want)
+    assert np.all(f[:, 3][1:] == 0.0)  # n = 1: no interface
+    assert np.all(f[:, 0][c[:, 0] < 0.98] == 1.0)  # n = 0.14: total internal reflection below c ≈ 0.99

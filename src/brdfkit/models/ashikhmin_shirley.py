@@ -80,7 +80,7 @@ from __future__ import annotations
 import math
 
 from ..engine import jit
-from ..geometry import dot3, half_vector_c
+from ..geometry import NORMAL_MIN, dot3, half_vector_c
 from ..params import Param, exponent_param
 from ..registry import register
 from ..terms.fresnel import f_schlick
@@ -99,16 +99,15 @@ def anisotropic_cos_power(hx, hy, hz, nu, nv):
     """
     s2 = hx * hx + hy * hy
     t = nu * hx * hx + nv * hy * hy
-    if t <= 0.0:
-        return 1.0
-    if s2 < 0.5:
-        lg = math.log1p(-s2)
-    elif hz > 0.0:
-        lg = 2.0 * math.log(hz)
-    else:
-        return 0.0  # h in the tangent plane: (n·h)^e = 0 for e > 0
-    q = lg / s2 if s2 > 0.0 else -1.0
-    return math.exp(0.5 * q * t)
+    # both logarithms computed (arguments guarded), one selected: no branch around log1p/log/exp,
+    # so a loop over this function vectorises (brdfkit.engine.vecmath)
+    small = s2 < 0.5
+    lg = math.log1p(-min(s2, 0.5)) if small else 2.0 * math.log(max(hz, NORMAL_MIN))
+    q = lg / (s2 if s2 > 0.0 else 1.0)
+    q = q if s2 > 0.0 else -1.0
+    v = math.exp(0.5 * q * t)
+    v = v if (small or hz > 0.0) else 0.0  # h in the tangent plane: (n·h)^e = 0 for e > 0
+    return 1.0 if t <= 0.0 else v
 
 
 @jit

@@ -85,6 +85,7 @@ import math
 import numpy as np
 
 from ..engine import jit
+from ..geometry import hypot_c
 from ..params import Param, kd_param
 from ..registry import register
 from .base import BRDF
@@ -96,7 +97,7 @@ COS_FLOOR = 1e-6
 @jit
 def polar_angles(x, y, z):
     """sin θ, cos θ, θ and the unit azimuth vector (cos φ, sin φ) of a direction (zeros at the normal)."""
-    st = math.hypot(x, y)
+    st = hypot_c(x, y)
     theta = math.atan2(st, z)
     if st > 0.0:
         return st, z, theta, x / st, y / st

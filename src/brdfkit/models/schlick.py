@@ -138,7 +138,7 @@ import math
 import numpy as np
 
 from ..engine import jit
-from ..geometry import dot3, half_vector_c
+from ..geometry import dot3, half_vector_c, hypot_c
 from ..params import Param
 from ..registry import register
 from ..terms.fresnel import f_schlick, fresnel_schlick
@@ -184,10 +184,10 @@ def azimuth_factor(hx, hy, p):
     if p == 1.0:
         return 1.0
     sp = math.sqrt(p)
-    den = math.hypot(sp * hy, hx / sp)
-    if den == 0.0:  # only at hx = hy = 0 (h = n): A is undefined there, take 1
-        return 1.0
-    return math.hypot(hx, hy) / den
+    den = hypot_c(sp * hy, hx / sp)
+    # den = 0 only at hx = hy = 0 (h = n): A is undefined there, take 1 (a select, no branch)
+    a = hypot_c(hx, hy) / (den if den != 0.0 else 1.0)
+    return a if den != 0.0 else 1.0
 
 
 @jit

@@ -154,17 +154,15 @@ def lambda_beckmann(wx, wy, wz, ax, ay):
 
     0 at normal incidence (s = 0), +inf for ``w_z <= 0``, never NaN or negative.
     """
-    if wz <= 0.0:
-        return math.inf
     s = projected_slope(wx, wy, ax, ay)
-    if s <= 0.0:
-        return 0.0
-    a = wz / s
+    # computed for every direction, the cases selected after (no branch around erfc: a loop over
+    # this function vectorises, erfc included, see brdfkit.engine.vecmath); guarded divisions
+    a = wz / (s if s > 0.0 else 1.0)
     den = a * _SQRT_PI
-    if den <= 0.0:
-        return math.inf  # a underflowed (w_z ~ 5e-324): fully masked, G1 = 0
-    lam = 0.5 * (math.exp(-a * a) / den - math.erfc(a))
-    return max(lam, 0.0)
+    lam = max(0.5 * (math.exp(-a * a) / (den if den > 0.0 else 1.0) - math.erfc(a)), 0.0)
+    lam = math.inf if den <= 0.0 else lam  # a underflowed (w_z ~ 5e-324): fully masked, G1 = 0
+    lam = 0.0 if s <= 0.0 else lam
+    return math.inf if wz <= 0.0 else lam
 
 
 @jit

@@ -30,6 +30,7 @@ import math
 import numpy as np
 
 from ..engine import jit, vectorize
+from ..geometry import hypot_c
 
 # ------------------------------------------------------------ scalar sources
 
@@ -44,22 +45,20 @@ def f_dielectric(c, n):
     c = min(max(c, 0.0), 1.0)
     d = n * n - 1.0
     g2 = d + c * c
-    if g2 < 0.0:
-        return 1.0
-    # for n >= 1, g = hypot(sqrt(n² − 1), c) so that c² cannot underflow away
-    if d >= 0.0:
-        g = math.hypot(math.sqrt(d), c)
-    else:
-        g = math.sqrt(g2)
+    # with e = sqrt(|n² − 1|): g = hypot(e, c) for n >= 1 (c² cannot underflow away), and
+    # g = sqrt((c − e)(c + e)) for n < 1 (no cancellation; 0 under TIR, selected away below).
+    # Every branch of this function is a select: both sides are computed, each with a
+    # non-negative square root argument in every lane, so a loop over it vectorises without
+    # raising the invalid-operation flag (numpy would warn for the array form)
+    e = math.sqrt(abs(d))
+    g = hypot_c(e, c) if d >= 0.0 else math.sqrt(max((c - e) * (c + e), 0.0))
     gc = g + c
-    if gc == 0.0:
-        return 0.0
-    a = (g - c) / gc
+    a = (g - c) / (gc if gc != 0.0 else 1.0)  # gc = 0 only for n = 1 at c = 0: a = 0, F = 0
     num = c * gc - 1.0
     den = c * (g - c) + 1.0  # > 0 for c in [0, 1] unless n == 0
-    q = num / den
-    F = 0.5 * a * a * (1.0 + q * q)
-    return min(max(F, 0.0), 1.0)
+    q = num / (den if den != 0.0 else 1.0)
+    F = min(max(0.5 * a * a * (1.0 + q * q), 0.0), 1.0)
+    return 1.0 if g2 < 0.0 else F  # total internal reflection
 
 
 @jit(inline=True)
