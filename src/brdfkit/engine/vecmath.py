@@ -37,6 +37,8 @@ import re
 import sys
 import threading
 
+#: glibc's libmvec, by its soname
+SONAME = "libmvec.so.1"
 #: environment variable: "0" turns vector math off (read at import)
 ENV_VAR = "BRDFKIT_VECTOR_MATH"
 #: the vector intrinsics renamed after optimisation, with their number of vector operands
@@ -172,7 +174,11 @@ def compiling() -> _Compiling:
 def _find_library() -> str | None:
     if sys.platform != "linux" or platform.machine() not in ("x86_64", "AMD64"):
         return None
-    return ctypes.util.find_library("mvec")
+    try:  # by its soname first: dlopen is immediate, find_library runs ldconfig (~5 ms)
+        ctypes.CDLL(SONAME)
+        return SONAME
+    except OSError:
+        return ctypes.util.find_library("mvec")
 
 
 def _cpu_features() -> set[str]:
