@@ -8,8 +8,10 @@ such a compiled loop; that a driver calling libmvec has its own cache file name.
 """
 
 import math
+import os
 import platform
 import re
+import subprocess
 import sys
 
 import numba
@@ -103,7 +105,7 @@ def test_annotated_module_parses_and_a_scalar_erfc_loop_vectorises():
 
     x = np.linspace(-3, 3, 4096)
     out = np.empty_like(x)
-    with vecmath.compiling():
+    with vecmath.compiling("all"):
         loop(x, 2.5, out)
     asm = loop.inspect_asm(loop.signatures[0])
     assert re.search(r"_ZGV[bde]N\d+v_erfc", asm) and re.search(r"_ZGV[bde]N\d+vv_pow", asm)
@@ -137,7 +139,7 @@ def test_compiling_context_turns_libmvec_on_for_that_compile_only():
     x = np.linspace(-5, 5, 64)
     plain, vm = _loop(), _loop()
     plain(x, x + 6, np.empty_like(x))
-    with vecmath.compiling():
+    with vecmath.compiling("all"):
         vm(x, x + 6, np.empty_like(x))
     asm_plain = plain.inspect_asm(plain.signatures[0])
     asm_vm = vm.inspect_asm(vm.signatures[0])
@@ -171,7 +173,7 @@ def test_libmvec_accuracy_and_special_values_through_a_compiled_loop(dtype):
             op[i] = c[i] ** d[i]
 
     oe, ol, op = np.empty_like(xe), np.empty_like(xl), np.empty_like(xp)
-    with vecmath.compiling():
+    with vecmath.compiling("all"):
         run(xe, xl, xp, yp, oe, ol, op)
     assert "_ZGV" in run.inspect_asm(run.signatures[0])
     wide = np.float64 if dtype == np.float32 else np.longdouble
@@ -188,6 +190,42 @@ def _compare(dtype, wide, xe, xl, xp, yp, oe, ol, op):
         ulp = np.spacing(np.abs(want_r[fin]).astype(dtype)).astype(wide)
         err = np.abs(got[fin].astype(wide) - want[fin]) / ulp
         assert err.max() <= 4.0, err.max()
+
+
+def test_drivers_scope_edits_the_drivers_modules_only(tmp_path):
+    """In the engine's scope a driver calls libmvec, the terms compiled meanwhile do not (their
+    cache is shared with processes that have vector math off); an ad-hoc loop is left alone."""
+    if not vecmath.available():  # pragma: no cover
+        pytest.skip("no libmvec on this platform")
+    code = (
+        "import re, numpy as np, brdfkit as bk\n"
+        "from brdfkit.engine import driver\n"
+        "from brdfkit.terms import distributions\n"
+        "from brdfkit.geometry import random_unit_vectors\n"
+        "rng = np.random.default_rng(0)\n"
+        "w1, w2 = random_unit_vectors(50000, rng), random_unit_vectors(50000, rng)\n"
+        "bk.model('microfacet', distribution='beckmann').eval(w1, w2)\n"
+        "d = [d for d in driver._SERIAL.values() if d.signatures][0]\n"
+        "print(sorted(set(re.findall(r'call [^@\\n]*@(_ZGV\\w+)', d.inspect_llvm(d.signatures[0])))))\n"
+        "f = distributions.lambda_beckmann\n"
+        "print('vector-function-abi-variant' in f.inspect_llvm(f.signatures[0]))\n"
+    )
+    env = dict(os.environ, BRDFKIT_CACHE_DIR=str(tmp_path), NUMBA_NUM_THREADS="1")
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True).stdout.split("\n")
+    assert re.search(r"_ZGV[bde]N\d+v_erfc", out[0]), out  # Beckmann's Smith Λ: erfc per vector
+    assert out[1] == "False"  # the term lambda_beckmann, compiled meanwhile: as numba writes it
+
+    @numba.njit(error_model="numpy")
+    def loop(x, out):
+        for i in range(x.size):
+            out[i] = math.exp(x[i])
+
+    x = np.linspace(-3, 3, 256)
+    with vecmath.compiling():  # the drivers' scope: not a driver, not edited
+        loop(x, np.empty_like(x))
+    assert "_ZGV" not in loop.inspect_asm(loop.signatures[0])
+    with pytest.raises(ValueError, match="scope"):
+        vecmath.compiling("everything")
 
 
 def test_a_driver_calling_libmvec_has_its_own_cache_file():

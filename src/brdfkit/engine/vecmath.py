@@ -6,7 +6,8 @@ needs an SVML-built llvmlite (PyPI's is not), and LLVM's ``-vector-library`` opt
 the pass pipelines llvmlite drives (tried). glibc's libmvec (on every x86-64 glibc >= 2.22) holds
 vector versions under the x86 vector-function ABI names, ``_ZGV<isa>N<lanes><v per arg>_<name>``
 (isa ``b`` SSE, ``d`` AVX2, ``e`` AVX-512; float32 names end in ``f``). While a driver compiles
-(:func:`compiling`), its module is edited twice, as text:
+(:func:`compiling`), its module (not those of the terms it calls, compiled meanwhile: their code is
+linked into the driver's and optimised there again) is edited twice, as text:
 
 * before optimisation (:func:`annotate`), each call of a scalar math function that libmvec holds
   gets LLVM's ``"vector-function-abi-variant"`` attribute naming its vector versions (the mechanism
@@ -23,7 +24,8 @@ compiled so have their own cache files (``driver._stem``), so a process with vec
 (``BRDFKIT_VECTOR_MATH=0``, or no libmvec) never loads one.
 
 The hook wraps numba's ``CPUCodeLibrary._optimize_final_module`` (numba 0.6x): it acts only inside
-:func:`compiling`, on the compiling thread; any other numba compile in the process is unchanged.
+:func:`compiling`, on the compiling thread, on the drivers' modules; any other numba compile in the
+process is unchanged.
 Where numba lacks that method, vector math is off and the drivers are as before.
 """
 
@@ -151,14 +153,21 @@ def available() -> bool:
     return _installed and bool(_names)
 
 
+#: the name every generated driver's functions carry (their module is brdfkit._engine_drivers.*)
+DRIVER_MARK = "_engine_drivers"
+
+
 class _Compiling:
     """The context of :func:`compiling` (a class: entering costs ~0.2 µs, the one-pair path runs it too)."""
 
-    __slots__ = ("prev",)
+    __slots__ = ("prev", "scope")
+
+    def __init__(self, scope: str) -> None:
+        self.scope = scope
 
     def __enter__(self):
-        self.prev = getattr(_state, "on", False)
-        _state.on = True
+        self.prev = getattr(_state, "on", None)
+        _state.on = self.scope
         return self
 
     def __exit__(self, *exc):
@@ -166,9 +175,27 @@ class _Compiling:
         return False
 
 
-def compiling() -> _Compiling:
-    """Rename vector intrinsics to libmvec in what numba compiles on this thread meanwhile (a context)."""
-    return _Compiling()
+def compiling(scope: str = "drivers") -> _Compiling:
+    """A context: numba compiles on this thread meanwhile call libmvec (where LLVM vectorises).
+
+    ``scope="drivers"`` (the engine's): only the generated drivers' own code modules, whose
+    cache files are apart (``driver._stem``); the terms they call, compiled meanwhile, stay as
+    numba writes them (their cache is shared with processes that have vector math off), and
+    are vectorised inside the driver, where their code is linked in and optimised again.
+    ``scope="all"``: every module compiled meanwhile (tests, experiments).
+    """
+    if scope not in ("drivers", "all"):
+        raise ValueError(f"scope must be 'drivers' or 'all', not {scope!r}")
+    return _Compiling(scope)
+
+
+def _applies(library) -> bool:
+    scope = getattr(_state, "on", None)
+    if not scope or not _names:
+        return False
+    if scope == "all":
+        return True
+    return any(DRIVER_MARK in f.name for f in library._final_module.functions if not f.is_declaration)
 
 
 def _find_library() -> str | None:
@@ -214,7 +241,7 @@ def _install_hook() -> bool:
         return True
 
     def _optimize_final_module(self):
-        on = getattr(_state, "on", False) and bool(_names)
+        on = _applies(self)
         if on:
             _replace(self, annotate)
         original(self)
