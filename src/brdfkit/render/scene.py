@@ -56,7 +56,7 @@ from ..jsonsafe import nesting_exceeds
 from .camera import camera_matrices
 from .image import TONEMAPS, save_image, to_display, to_uint8
 from .meshes import BUILTIN, Mesh, mesh_from_spec
-from .renderer import Scene, render_linear
+from .renderer import SHADINGS, Scene, render_linear
 
 SCENE_FIELDS = (
     "mesh", "camera", "size", "lights", "light_model", "material", "shading",
@@ -258,6 +258,9 @@ def _check_fields(obj: Mapping[str, Any]) -> None:
     for k in ("shading", "tonemap"):
         if k in obj and not isinstance(obj[k], str):
             raise ValueError(f"scene field '{k}': must be a name (a string), got {_short(obj[k])}")
+    if "shading" in obj and obj["shading"] not in SHADINGS:
+        # checked here, so that the message names the scene field (the renderer's own says "shading must be")
+        raise ValueError(f"scene field 'shading': must be one of {', '.join(SHADINGS)}, got {_short(obj['shading'])}")
     for k in ("antialias", "srgb"):
         if k in obj and not isinstance(obj[k], bool):
             raise ValueError(f"scene field '{k}': must be true or false, got {_short(obj[k])}")
