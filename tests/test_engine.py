@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import os
 import subprocess
 import sys
@@ -360,3 +361,56 @@ def test_specialised_driver_runs_serially_or_in_parallel_with_the_same_bits(name
     with pytest.raises(ValueError, match="wi must be unit"):
         m.eval(bad, wo)
     assert calls == [1, 1]
+
+
+def test_threading_layer_is_tbb_here_and_calls_from_threads_agree():
+    """brdfkit depends on PyPI's tbb: numba's TBB layer loads (its library found by path) and
+    is used; calls from several Python threads at once (the explorer's server) give the bits of
+    the same calls made one after another."""
+    import platform
+    import threading
+
+    import numba
+
+    from brdfkit.engine import driver
+
+    if "NUMBA_THREADING_LAYER" not in os.environ and platform.machine() == "x86_64":
+        assert engine.THREADING_LAYER == "tbb"
+    m = bk.model("microfacet", distribution="beckmann")
+    pairs = [_pairs(20000 + 1000 * k, seed=k) for k in range(6)]
+    want = [m.eval(wi, wo) for wi, wo in pairs]
+    assert numba.threading_layer() == engine.THREADING_LAYER
+    got = [None] * len(pairs)
+
+    def work(k):
+        for _ in range(3):
+            got[k] = m.eval(*pairs[k])
+
+    threads = [threading.Thread(target=work, args=(k,)) for k in range(len(pairs))]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    for a, b in zip(got, want):
+        np.testing.assert_array_equal(a, b)
+    if engine.THREADING_LAYER == "tbb":
+        assert isinstance(driver._RUN_LOCK, type(contextlib.nullcontext()))
+
+
+def test_a_forked_child_evaluates_after_the_parent_ran_parallel_calls():
+    """TBB's pool is shut down around fork() by numba: a forked worker (check --all --jobs) works."""
+    code = (
+        "import concurrent.futures as cf, multiprocessing as mp, numpy as np, brdfkit as bk\n"
+        "from brdfkit.geometry import random_unit_vectors as r\n"
+        "g = np.random.default_rng(0); wi, wo = r(50000, g), r(50000, g)\n"
+        "m = bk.model('ward')\n"
+        "a = m.eval(wi, wo)\n"
+        "def child(_):\n"
+        "    return m.eval(wi, wo)\n"
+        "with cf.ProcessPoolExecutor(2, mp_context=mp.get_context('fork')) as ex:\n"
+        "    res = list(ex.map(child, range(2)))\n"
+        "print(all(np.array_equal(a, b) for b in res))\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr[-2000:]
+    assert out.stdout.strip() == "True"

@@ -50,6 +50,7 @@ from ..fileio import write_text
 from .cache import cache_dir, in_cache_dir, jit
 from .evaluate import _sq_stats  # the exact length statistics, shared with the generic check
 from . import vecmath
+from .. import engine as _engine
 
 CHUNK = 2048
 #: the specialised driver passes ``p`` as a tuple; kernels with longer ``p`` (tables) keep the generic one
@@ -190,8 +191,10 @@ PARALLEL_MIN_S = 2e-3
 #: seconds per pair on one thread, measured on each driver's calls after its first (by key)
 _PAIR_COST: dict[tuple, float] = {}
 _LOCK = threading.Lock()
-#: one parallel launch at a time (numba's workqueue layer is not reentrant across threads)
-_RUN_LOCK = threading.Lock()
+#: one parallel launch at a time where numba's layer is workqueue (not reentrant across threads);
+#: TBB and OpenMP are thread-safe: no lock (brdfkit.engine.THREADING_LAYER)
+_RUN_LOCK = (contextlib.nullcontext() if _engine.THREADING_LAYER in ("tbb", "safe", "threadsafe", "omp")
+             else threading.Lock())
 
 
 #: LLVM's loop-vectoriser width for the float32 specialised drivers: 16 lanes (one AVX-512 register).
