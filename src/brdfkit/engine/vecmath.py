@@ -74,12 +74,17 @@ _library: str | None = None
 _installed = False
 
 
+def _abi_name(isa: str, lanes: int, fn: str, nargs: int, ty: str) -> str:
+    """The x86 vector-function ABI name: ``_ZGV<isa>N<lanes><v per argument>_<fn>[f]`` (no mask)."""
+    return f"_ZGV{isa}N{lanes}{'v' * nargs}_{fn}{'f' if ty == 'f32' else ''}"
+
+
 def vector_name(fn: str, lanes: int, ty: str) -> str | None:
     """libmvec's name for ``fn`` on ``lanes`` elements of ``ty`` ("f32"/"f64"), or None (no such ISA)."""
     isa = _ISA.get((ty, lanes))
     if isa is None or fn not in FUNCTIONS:
         return None
-    return f"_ZGV{isa}N{lanes}{'v' * FUNCTIONS[fn]}_{fn}{'f' if ty == 'f32' else ''}"
+    return _abi_name(isa, lanes, fn, FUNCTIONS[fn], ty)
 
 
 def rewrite(ir: str, names: dict[tuple[str, int, str], str] | None = None) -> str:
@@ -265,7 +270,7 @@ def _setup() -> None:
         import llvmlite.binding as ll
 
         ll.load_library_permanently(path)  # cached drivers resolve their libmvec calls through it
-    except OSError:  # pragma: no cover - listed but not loadable
+    except (OSError, RuntimeError):  # pragma: no cover - listed but not loadable (llvmlite: RuntimeError)
         return
     feats = _cpu_features()
     for (ty, lanes), isa in _ISA.items():
@@ -279,7 +284,7 @@ def _setup() -> None:
         for fn, nargs in SCALAR_FUNCTIONS.items():
             found = []
             for isa, lanes in widths:
-                name = f"_ZGV{isa}N{lanes}{'v' * nargs}_{fn}{'f' if ty == 'f32' else ''}"
+                name = _abi_name(isa, lanes, fn, nargs, ty)
                 if _ISA_FEATURE[isa] in feats and hasattr(lib, name):
                     found.append((lanes, name))
             if found:
