@@ -149,7 +149,7 @@ THREADING_LAYER = os.environ.get("NUMBA_THREADING_LAYER", "")
 # `check --all --jobs`, batch fitting), and its workers spin a moment before they sleep, so that
 # the many short parallel calls of the engine find them awake (GGX on 2^20 pairs: median 480 M
 # evals/s against 200 on workqueue on the 2-vCPU development machine, where waking a sleeping
-# vCPU takes about a millisecond). Otherwise "workqueue", which also survives fork() but is not
+# vCPU appears to take about a millisecond: inferred from those timings, not measured directly). Otherwise "workqueue", which also survives fork() but is not
 # reentrant: the driver then serialises calls from several Python threads with a lock. GNU
 # OpenMP, numba's other choice here, aborts a forked child. An explicit NUMBA_THREADING_LAYER wins.
 if not THREADING_LAYER:

@@ -187,6 +187,7 @@ _SERIAL: dict[tuple, Callable] = {}
 #: thread runs serially. Measured here (2 cores, load 0.5), serial / parallel: GGX microfacet 3000
 #: pairs 0.14 / 0.38 ms, 48 000 pairs 1.3 / 1.7 ms, 96 000 pairs 2.4 / 2.2 ms; Lambert 96 000 pairs
 #: 0.44 / 0.59 ms; HTSG 3000 pairs 4.6 / 3.1 ms: a launch on numba's workqueue layer costs ~0.2-0.5 ms
+#: (measured on workqueue, before the TBB layer became the default: not yet measured again on TBB)
 PARALLEL_MIN_S = 2e-3
 #: seconds per pair on one thread, measured on each driver's calls after its first (by key)
 _PAIR_COST: dict[tuple, float] = {}
