@@ -9,8 +9,9 @@ says which one is active (SPEC.md, "Evaluation engine"). Default: ``compiled``.
   parallel driver over flat views of the direction arrays (chunked ``prange``), float32
   or float64 in and out, output allocated once. Where the driver's loop vectorises, its
   math functions (exp, erfc, pow, atan2, ...) are glibc's libmvec vector functions
-  (:mod:`.vecmath`; write kernels without branches around them, so that they do). float32 input runs the kernel's float32 twin
-  (:mod:`.precision`), compiled with LLVM's ``contract`` flag only (fused multiply-adds). Kernels are cached on disk (see :mod:`.cache`), so a new
+  (:mod:`.vecmath`; write kernels without branches around them, so that they do). float32
+  input runs the kernel's float32 twin (:mod:`.precision`), compiled with LLVM's ``contract``
+  flag only (fused multiply-adds). Kernels are cached on disk (see :mod:`.cache`), so a new
   process pays no compile.
 * ``reference`` — THE SAME kernel functions, uncompiled: every numba dispatcher
   the kernel calls is replaced by its original Python function
@@ -149,9 +150,10 @@ THREADING_LAYER = os.environ.get("NUMBA_THREADING_LAYER", "")
 # `check --all --jobs`, batch fitting), and its workers spin a moment before they sleep, so that
 # the many short parallel calls of the engine find them awake (GGX on 2^20 pairs: median 480 M
 # evals/s against 200 on workqueue on the 2-vCPU development machine, where waking a sleeping
-# vCPU appears to take about a millisecond: inferred from those timings, not measured directly). Otherwise "workqueue", which also survives fork() but is not
-# reentrant: the driver then serialises calls from several Python threads with a lock. GNU
-# OpenMP, numba's other choice here, aborts a forked child. An explicit NUMBA_THREADING_LAYER wins.
+# vCPU appears to take about a millisecond: inferred from those timings, not measured directly).
+# Otherwise "workqueue", which also survives fork() but is not reentrant: the driver then
+# serialises calls from several Python threads with a lock. GNU OpenMP, numba's other choice
+# here, aborts a forked child. An explicit NUMBA_THREADING_LAYER wins.
 if not THREADING_LAYER:
     import numba as _numba
 

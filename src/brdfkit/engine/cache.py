@@ -134,7 +134,7 @@ JIT_OPTIONS = dict(cache=True, error_model="numpy", nogil=True)
 
 
 def jit(fn: Callable | None = None, *, inline: bool = False, reassociate: bool = False) -> Callable:
-    """Decorator for scalar terms and kernels: nopython, cached, ``error_model="numpy"``, no fastmath.
+    """Decorator for scalar terms and kernels: nopython, cached, ``error_model="numpy"``, no fastmath (but ``reassociate``).
 
     ``@jit(inline=True)`` also inlines the function into its numba callers (numba IR
     inlining, ``inline="always"``): for the small dispatchers over a choice index
