@@ -113,25 +113,19 @@ def _load_tbb() -> bool:
     """
     import ctypes
     import glob
+    from importlib.metadata import PackageNotFoundError, files
 
-    candidates = [os.path.join(_sys.prefix, "lib", "libtbb.so.12")]
     try:
-        from importlib.metadata import PackageNotFoundError, files
-
-        try:
-            candidates += [str(f.locate()) for f in files("tbb") or () if f.name.startswith("libtbb.so.12")]
-        except PackageNotFoundError:
-            pass
-    except ImportError:  # pragma: no cover
-        pass
-    candidates += glob.glob(os.path.join(_sys.prefix, "lib", "libtbb.so.12*"))
+        candidates = [str(f.locate()) for f in files("tbb") or () if f.name.startswith("libtbb.so.12")]
+    except PackageNotFoundError:  # not installed by pip: perhaps in the environment's lib/ anyway
+        candidates = []
+    candidates += sorted(glob.glob(os.path.join(_sys.prefix, "lib", "libtbb.so.12*")))
     for path in candidates:
-        if os.path.exists(path):
-            try:
-                ctypes.CDLL(path, mode=ctypes.RTLD_GLOBAL)
-                break
-            except OSError:
-                continue
+        try:
+            ctypes.CDLL(path, mode=ctypes.RTLD_GLOBAL)
+            break
+        except OSError:
+            continue
     try:
         from numba.np.ufunc import parallel as _parallel
         from numba.np.ufunc import tbbpool  # noqa: F401  (fails without libtbb)

@@ -43,8 +43,6 @@ import threading
 SONAME = "libmvec.so.1"
 #: environment variable: "0" turns vector math off (read at import)
 ENV_VAR = "BRDFKIT_VECTOR_MATH"
-#: the vector intrinsics renamed after optimisation, with their number of vector operands
-FUNCTIONS = {"exp": 1, "log": 1, "pow": 2}
 #: the scalar functions annotated before optimisation (libm names; numba calls exp, log, pow, sin and
 #: cos as LLVM intrinsics, the others by their libm names), with their number of arguments
 SCALAR_FUNCTIONS = {
@@ -52,11 +50,13 @@ SCALAR_FUNCTIONS = {
     "atan2": 2, "acos": 1, "asin": 1, "atan": 1, "tan": 1, "sinh": 1, "cosh": 1, "tanh": 1, "hypot": 2,
     "exp2": 1, "log2": 1, "log10": 1, "cbrt": 1,
 }
+#: the vector intrinsics renamed after optimisation (those LLVM writes for numba's exp, log, pow)
+FUNCTIONS = {fn: SCALAR_FUNCTIONS[fn] for fn in ("exp", "log", "pow")}
 #: the vector-function ABI widths: float64 on SSE/AVX2/AVX-512, float32 likewise
 _WIDTHS = {"f64": (("b", 2), ("d", 4), ("e", 8)), "f32": (("b", 4), ("d", 8), ("e", 16))}
 _LLTYPE = {"f64": "double", "f32": "float"}
 #: (element type, lanes) -> the vector-function ABI's ISA letter
-_ISA = {("f64", 2): "b", ("f64", 4): "d", ("f64", 8): "e", ("f32", 4): "b", ("f32", 8): "d", ("f32", 16): "e"}
+_ISA = {(ty, lanes): isa for ty, widths in _WIDTHS.items() for isa, lanes in widths}
 #: the CPU feature (LLVM's name) each ISA letter needs
 _ISA_FEATURE = {"b": "sse4.2", "d": "avx2", "e": "avx512f"}
 _INTRINSIC = re.compile(r"@llvm\.(exp|log|pow)\.v(\d+)(f32|f64)\b")
@@ -70,7 +70,6 @@ _variants: dict[str, list[tuple[int, str]]] = {}
 _signature: dict[str, tuple[int, str]] = {}
 #: attribute-group numbers for the annotations (far above what numba's modules use)
 _ATTR_BASE = 900000
-_library: str | None = None
 _installed = False
 
 
@@ -203,14 +202,18 @@ def _applies(library) -> bool:
     return any(DRIVER_MARK in f.name for f in library._final_module.functions if not f.is_declaration)
 
 
-def _find_library() -> str | None:
+def _open_library() -> tuple[str, ctypes.CDLL] | None:
+    """libmvec's path and handle, or None (not Linux x86-64, or not found)."""
     if sys.platform != "linux" or platform.machine() not in ("x86_64", "AMD64"):
         return None
-    try:  # by its soname first: dlopen is immediate, find_library runs ldconfig (~5 ms)
-        ctypes.CDLL(SONAME)
-        return SONAME
-    except OSError:
-        return ctypes.util.find_library("mvec")
+    # by its soname first: dlopen is immediate, find_library runs ldconfig (~5 ms)
+    for path in (SONAME, ctypes.util.find_library("mvec")):
+        if path:
+            try:
+                return path, ctypes.CDLL(path)
+            except OSError:
+                continue
+    return None
 
 
 def _cpu_features() -> set[str]:
@@ -259,40 +262,35 @@ def _install_hook() -> bool:
 
 
 def _setup() -> None:
-    global _library, _installed
+    global _installed
     if os.environ.get(ENV_VAR, "1").strip() == "0":
         return
-    path = _find_library()
-    if path is None:
+    opened = _open_library()
+    if opened is None:
         return
+    path, lib = opened
     try:
-        lib = ctypes.CDLL(path)
         import llvmlite.binding as ll
 
         ll.load_library_permanently(path)  # cached drivers resolve their libmvec calls through it
-    except (OSError, RuntimeError):  # pragma: no cover - listed but not loadable (llvmlite: RuntimeError)
+    except RuntimeError:  # pragma: no cover - opened by ctypes but not by LLVM
         return
     feats = _cpu_features()
-    for (ty, lanes), isa in _ISA.items():
-        if _ISA_FEATURE[isa] not in feats:
-            continue
-        for fn in FUNCTIONS:
-            name = vector_name(fn, lanes, ty)
-            if hasattr(lib, name):
-                _names[(fn, lanes, ty)] = name
+    # one pass over what libmvec exports for this CPU: the annotations' variants (by scalar
+    # symbol) and, for exp/log/pow, the renames of the vector intrinsics (by function and width)
     for ty, widths in _WIDTHS.items():
         for fn, nargs in SCALAR_FUNCTIONS.items():
-            found = []
-            for isa, lanes in widths:
-                name = _abi_name(isa, lanes, fn, nargs, ty)
-                if _ISA_FEATURE[isa] in feats and hasattr(lib, name):
-                    found.append((lanes, name))
-            if found:
-                for sym in _scalar_symbols(fn, ty):
-                    _variants[sym] = found
-                    _signature[sym] = (nargs, _LLTYPE[ty])
+            found = [(lanes, _abi_name(isa, lanes, fn, nargs, ty)) for isa, lanes in widths
+                     if _ISA_FEATURE[isa] in feats and hasattr(lib, _abi_name(isa, lanes, fn, nargs, ty))]
+            if not found:
+                continue
+            for sym in _scalar_symbols(fn, ty):
+                _variants[sym] = found
+                _signature[sym] = (nargs, _LLTYPE[ty])
+            if fn in FUNCTIONS:
+                for lanes, name in found:
+                    _names[(fn, lanes, ty)] = name
     if _names:
-        _library = path
         _installed = _install_hook()
 
 

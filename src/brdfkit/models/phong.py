@@ -80,7 +80,7 @@ def phong_family_lobe(lobe, wiz, normalized, norm):
 
 
 #: 2^1023 (a float32 twin maps it to its cap, 2^126: the step is still exactly 0 or 1)
-_TWO_1023 = 8.98846567431158e307
+_TWO_1023 = 2.0 ** 1023
 
 
 @jit
