@@ -414,3 +414,38 @@ def test_a_forked_child_evaluates_after_the_parent_ran_parallel_calls():
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
     assert out.returncode == 0, out.stderr[-2000:]
     assert out.stdout.strip() == "True"
+
+
+def test_the_console_script_skips_numbas_blas_probe_and_scipy_linalg_still_imports(tmp_path):
+    """brdfkit.cli.run() first imports numba's arraymath with scipy.linalg held back (its BLAS probe
+    imported all of scipy.linalg, 0.1-0.3 s per command): a model then evaluates with the same bits,
+    scipy.linalg was not imported for it, imports normally afterwards (a fit needs it), and numba's
+    1-D np.dot in jitted code still computes (its own loop). In a process that imported either module
+    before, nothing is done."""
+    code = (
+        "import sys, numpy as np, numba\n"
+        "from brdfkit.engine import skip_blas_probe\n"
+        "assert skip_blas_probe() is True\n"
+        "assert skip_blas_probe() is False\n"  # arraymath is imported now: a second call does nothing
+        "import brdfkit as bk\n"
+        "from brdfkit.geometry import random_unit_vectors as r\n"
+        "g = np.random.default_rng(3); wi, wo = r(5000, g), r(5000, g)\n"
+        "v = bk.model('microfacet').eval(wi, wo)\n"
+        "print('linalg' if 'scipy.linalg' in sys.modules else 'no-linalg')\n"
+        "import scipy.linalg, scipy.optimize\n"
+        "print(float(scipy.linalg.norm([3.0, 4.0])))\n"
+        "d = numba.njit(lambda a, b: np.dot(a, b))(np.arange(4.0), np.ones(4))\n"
+        "print(d)\n"
+        "np.save(sys.argv[1], v)\n"
+    )
+    path = tmp_path / "v.npy"
+    out = subprocess.run([sys.executable, "-c", code, str(path)], capture_output=True, text=True, timeout=600)
+    assert out.returncode == 0, out.stderr[-2000:]
+    assert out.stdout.split() == ["no-linalg", "5.0", "6.0"]
+    g = np.random.default_rng(3)
+    wi, wo = random_unit_vectors(5000, g), random_unit_vectors(5000, g)
+    np.testing.assert_array_equal(np.load(path), bk.model("microfacet").eval(wi, wo))
+    # this test process imported numba's arraymath long ago: nothing to do
+    from brdfkit.engine import skip_blas_probe
+
+    assert skip_blas_probe() is False

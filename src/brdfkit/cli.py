@@ -146,7 +146,14 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def run() -> None:
-    """Console-script wrapper: exit with :func:`main`'s status."""
+    """Console-script wrapper: exit with :func:`main`'s status.
+
+    The process is brdfkit's own, so numba's import-time BLAS probe is skipped first
+    (:func:`brdfkit.engine.skip_blas_probe`: 0.1-0.3 s of every command that evaluates).
+    """
+    from .engine import skip_blas_probe
+
+    skip_blas_probe()
     sys.exit(main())
 
 
