@@ -270,3 +270,67 @@ def test_parameters_outside_float32_are_computed_in_float64():
         f = m.eval(wi32, wo32)
         ref = m.eval(wi32.astype(np.float64), wo32.astype(np.float64)).astype(np.float32)
         assert np.array_equal(f, ref), m  # the float64 value rounded once, as before the twin
+
+
+def _soa_cases():
+    for name in KERNEL_MODELS:
+        cls = bk.registry.get(name)
+        grid = list(_choice_grid(cls))
+        for fixed in grid[:: max(1, len(grid) // 3)]:  # a few choice combinations per model
+            yield pytest.param(name, fixed, id=name + "-" + "-".join(str(v) for v in fixed.values()) if fixed else name)
+
+
+@pytest.mark.parametrize("name,fixed", list(_soa_cases()))
+def test_fortran_ordered_directions_give_the_same_bits(name, fixed):
+    """Fortran-ordered (n, 3) directions (each component contiguous) run the structure-of-arrays driver
+    where it applies, in place: the values equal those of the same directions in rows (float64 bit for
+    bit; float32 to the rounding of its fused multiply-adds, which LLVM may place differently in the two
+    loops: 1 ulp on 3 of 13 209 values of one Schlick setting), the result is Fortran-ordered; a non-unit direction is refused the same way; under the
+    reference engine, and with one argument in rows, the rows path runs (same values again)."""
+    from brdfkit.engine import driver
+
+    n = driver.CHUNK * 2 + 301  # several chunks, the last one partial
+    wi, wo = _directions(n, seed=11)
+    m = bk.registry.get(name)(**fixed)
+    old = engine.engine()
+    try:
+        engine.set_engine("compiled")
+        for dt in (np.float64, np.float32):
+            a, b = wi.astype(dt), wo.astype(dt)
+            fa, fb = np.asfortranarray(a), np.asfortranarray(b)
+            want = m.eval(a, b)
+            got = m.eval(fa, fb)
+            assert got.dtype == want.dtype == dt and got.shape == want.shape
+            if dt == np.float64:
+                np.testing.assert_array_equal(got, want)
+            else:  # the float32 twins may fuse a·b + c (LLVM's contract): the two loops can fuse differently
+                np.testing.assert_allclose(got, want, rtol=1e-6, atol=0)
+            soa = driver.runs_soa(n, m.kernel_args()[0])
+            assert got.flags.f_contiguous == soa
+            np.testing.assert_array_equal(m.eval(fa, b), want)  # mixed layouts: copied to rows
+            bad = fa.copy(order="F")
+            bad[n - 5] *= 1.01
+            with pytest.raises(ValueError, match="wi must be unit"):
+                m.eval(bad, fb)
+            bad = fb.copy(order="F")
+            bad[7, 2] = np.nan
+            with pytest.raises(ValueError, match="wo must be unit"):
+                m.eval(fa, bad)
+        engine.set_engine("reference")
+        k = 40  # the reference engine is slow: a few pairs, Fortran-ordered, against the same in rows
+        fa, fb = np.asfortranarray(wi[-k:]), np.asfortranarray(wo[-k:])
+        np.testing.assert_array_equal(m.eval(fa, fb), m.eval(wi[-k:], wo[-k:]))
+    finally:
+        engine.set_engine(old)
+
+
+def test_the_soa_template_is_derived_from_the_specialised_one():
+    """One loop source: the structure-of-arrays driver differs from the specialised driver only in how it
+    addresses the components (and its header line)."""
+    from brdfkit.engine import driver
+
+    soa = driver.SOA_TEMPLATE.splitlines()
+    spec = driver.SPECIAL_TEMPLATE.splitlines()
+    differ = [line for line in spec if line not in soa]
+    assert differ and all(("[3 * " in line) or line.startswith("# Generated") for line in differ)
+    assert "a0[j]" in driver.SOA_TEMPLATE and "o2[j] =" in driver.SOA_TEMPLATE and "[3 * j" not in driver.SOA_TEMPLATE

@@ -71,7 +71,9 @@ class BRDF:
         vectors (within 1e-4, float32 1e-3); others raise ``ValueError``. Runs the
         model's compiled kernel, the same kernel uncompiled under
         ``bk.set_engine("reference")``, or ``_eval`` for a model without a kernel
-        (see :mod:`brdfkit.engine`).
+        (see :mod:`brdfkit.engine`). Fortran-ordered ``(n, 3)`` directions (each component
+        contiguous) are read in place where the compiled engine can, and give a Fortran-ordered
+        result of the same values (:func:`brdfkit.engine.evaluate.evaluate`).
         """
         from ..engine import evaluate
 
