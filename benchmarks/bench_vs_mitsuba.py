@@ -19,7 +19,9 @@ include Dr.Jit's kernel compilation and numba's cache load):
 * ``mitsuba kernel``: ``bsdf.eval`` on data already in Dr.Jit arrays, forced with
   ``dr.eval`` and ``dr.sync_thread`` (the time of the JIT-compiled kernel, cached);
 * ``mitsuba numpy``: numpy arrays in, Dr.Jit arrays built, eval, numpy array out;
-* ``brdfkit``: ``m.eval(wi, wo)`` on numpy arrays (the compiled engine), float32 and float64.
+* ``brdfkit``: ``m.eval(wi, wo)`` on numpy arrays (the compiled engine), float32 and float64, on
+  ``(n, 3)`` arrays in rows (C order) and with each component contiguous (Fortran order: the
+  layout of Dr.Jit's arrays, which brdfkit's structure-of-arrays driver reads in place).
 
 Each measurement runs in its own fresh process, the Mitsuba and brdfkit processes
 alternating for ``--rounds`` rounds; the figure is the median over rounds. Mitsuba from
@@ -141,8 +143,9 @@ def worker_brdfkit(n: int, calls: int, threads: int = 0) -> dict:
                  alpha=ALPHA, eta=ETA, k=K, kd=0.0, ks=1.0)
     wi, wo = directions(n)
     out = {}
-    for name, dt in (("f32_s", np.float32), ("f64_s", np.float64)):
-        a, b = wi.astype(dt), wo.astype(dt)
+    for name, dt, order in (("f32_s", np.float32, "C"), ("f64_s", np.float64, "C"),
+                            ("f32F_s", np.float32, "F"), ("f64F_s", np.float64, "F")):
+        a, b = wi.astype(dt, order=order), wo.astype(dt, order=order)
         out[name], out[name.replace("_s", "_best_s")] = _times(lambda: m.eval(a, b), calls)
     out["sample"] = m.eval(wi.astype(np.float32), wo.astype(np.float32))[:4096].astype(np.float64).tolist()
     return out
@@ -204,8 +207,11 @@ def main(argv=None) -> int:
     tn = med(r["numpy_s"] for r in mits)
     t32 = med(r["f32_s"] for r in bks)
     t64 = med(r["f64_s"] for r in bks)
+    t32f = med(r["f32F_s"] for r in bks)
+    t64f = med(r["f64F_s"] for r in bks)
     fastest = {k: min(r[k] for r in rows) for rows, ks in ((mits, ("kernel_best_s", "numpy_best_s")),
-                                                           (bks, ("f32_best_s", "f64_best_s"))) for k in ks}
+                                                           (bks, ("f32_best_s", "f64_best_s", "f32F_best_s", "f64F_best_s")))
+               for k in ks}
     a = np.array(mits[0]["sample"])
     b = np.array(bks[0]["sample"])
     ok = b > 1e-6
@@ -221,13 +227,18 @@ def main(argv=None) -> int:
         "mitsuba_numpy_Meval_s": rate(tn),
         "brdfkit_f32_Meval_s": rate(t32),
         "brdfkit_f64_Meval_s": rate(t64),
+        "brdfkit_f32_fortran_Meval_s": rate(t32f),
+        "brdfkit_f64_fortran_Meval_s": rate(t64f),
         "ratio_f32_vs_mitsuba_kernel": tk / t32,
+        "ratio_f32_fortran_vs_mitsuba_kernel": tk / t32f,
+        "ratio_f64_fortran_vs_mitsuba_kernel": tk / t64f,
         "ratio_f64_vs_mitsuba_kernel": tk / t64,
         "ratio_f32_vs_mitsuba_numpy": tn / t32,
         "ratio_f64_vs_mitsuba_numpy": tn / t64,
         "fastest_call_Meval_s": {k.replace("_best_s", ""): rate(v) for k, v in fastest.items()},
         "fastest_ratio_f32_vs_mitsuba_kernel": fastest["kernel_best_s"] / fastest["f32_best_s"],
         "fastest_ratio_f64_vs_mitsuba_kernel": fastest["kernel_best_s"] / fastest["f64_best_s"],
+        "fastest_ratio_f32_fortran_vs_mitsuba_kernel": fastest["kernel_best_s"] / fastest["f32F_best_s"],
         "threads": args.threads or "all",
         "median_rel_difference": agree,
         "load_average": os.getloadavg()[0] if hasattr(os, "getloadavg") else None,
@@ -243,12 +254,17 @@ def main(argv=None) -> int:
     print(f"  mitsuba llvm_ad_rgb numpy in/out            {res['mitsuba_numpy_Meval_s']:8.1f} M evals/s")
     print(f"  brdfkit compiled float32                    {res['brdfkit_f32_Meval_s']:8.1f} M evals/s")
     print(f"  brdfkit compiled float64                    {res['brdfkit_f64_Meval_s']:8.1f} M evals/s")
+    print(f"  brdfkit float32, Fortran-ordered (n, 3)     {res['brdfkit_f32_fortran_Meval_s']:8.1f} M evals/s")
+    print(f"  brdfkit float64, Fortran-ordered (n, 3)     {res['brdfkit_f64_fortran_Meval_s']:8.1f} M evals/s")
     print(f"  ratio brdfkit/mitsuba-kernel: float32 {res['ratio_f32_vs_mitsuba_kernel']:.2f}x, "
           f"float64 {res['ratio_f64_vs_mitsuba_kernel']:.2f}x")
+    print(f"  ratio with components contiguous (Fortran order, like Dr.Jit's arrays): float32 "
+          f"{res['ratio_f32_fortran_vs_mitsuba_kernel']:.2f}x, float64 {res['ratio_f64_fortran_vs_mitsuba_kernel']:.2f}x")
     print(f"  ratio brdfkit/mitsuba-numpy:  float32 {res['ratio_f32_vs_mitsuba_numpy']:.2f}x, "
           f"float64 {res['ratio_f64_vs_mitsuba_numpy']:.2f}x")
     print(f"  fastest single calls, the ratio: float32 {res['fastest_ratio_f32_vs_mitsuba_kernel']:.2f}x, "
-          f"float64 {res['fastest_ratio_f64_vs_mitsuba_kernel']:.2f}x (the least disturbed by other jobs)")
+          f"float64 {res['fastest_ratio_f64_vs_mitsuba_kernel']:.2f}x, float32 Fortran-ordered "
+          f"{res['fastest_ratio_f32_fortran_vs_mitsuba_kernel']:.2f}x (the least disturbed by other jobs)")
     print(f"  values agree to a median relative difference of {agree:.2g} (Fresnel forms differ)")
     return 0
 
