@@ -173,6 +173,8 @@ def skip_blas_probe() -> bool:
     _sys.modules["scipy.linalg"] = None  # type: ignore[assignment]
     try:
         import numba.np.arraymath  # noqa: F401
+    except ImportError:  # pragma: no cover - a numba whose arraymath needs scipy.linalg: its normal import later
+        return False
     finally:
         if _sys.modules.get("scipy.linalg", 0) is None:
             del _sys.modules["scipy.linalg"]
