@@ -334,3 +334,10 @@ def test_the_soa_template_is_derived_from_the_specialised_one():
     differ = [line for line in spec if line not in soa]
     assert differ and all(("[3 * " in line) or line.startswith("# Generated") for line in differ)
     assert "a0[j]" in driver.SOA_TEMPLATE and "o2[j] =" in driver.SOA_TEMPLATE and "[3 * j" not in driver.SOA_TEMPLATE
+    # the structure-of-arrays driver is only for the specialised calls: asked for one chunk, run() says so
+    m = bk.model("lambert")
+    p, c = m.kernel_args()
+    wi = np.asfortranarray(np.tile([0.0, 0.0, 1.0], (driver.CHUNK, 1)))
+    assert not driver.runs_soa(driver.CHUNK, p) and driver.runs_soa(driver.CHUNK + 1, p)
+    with pytest.raises(ValueError, match="soa=True needs more than 2048 pairs"):
+        driver.run(type(m).kernel, wi, wi, p, c, np.empty((driver.CHUNK, 3), order="F"), soa=True)

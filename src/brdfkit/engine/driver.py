@@ -26,7 +26,9 @@ the calling thread (``drive_serial``, the same loop) when numba has one thread o
 work, estimated from the driver's earlier calls, is below :data:`PARALLEL_MIN_S`: a parallel
 launch costs more than a fitter's evaluation of 3000 samples. LLVM vectorises that loop where the
 kernel calls no libm function (issue 9; README, "Speed"). Kernels whose ``p`` holds a
-table (longer than :data:`MAX_TUPLE`) keep the generic driver.
+table (longer than :data:`MAX_TUPLE`) keep the generic driver. Fortran-ordered ``(n, 3)`` arrays
+(each component contiguous) run :data:`SOA_TEMPLATE`, the specialised loop with unit-stride
+component access, derived from :data:`SPECIAL_TEMPLATE` by a checked list of edits.
 """
 
 from __future__ import annotations
@@ -427,6 +429,9 @@ def run(kernel: Callable, wi: np.ndarray, wo: np.ndarray, p: np.ndarray, c: np.n
     to the rounding of its fused multiply-adds).
     """
     n = wi.shape[0]
+    if soa and not runs_soa(n, p):
+        raise ValueError(f"driver.run: soa=True needs more than {CHUNK} pairs and no table in p (got {n} pairs, "
+                         f"{len(p)} parameters)")
     nrm = np.empty((nchunks(n), 6), dtype=np.float64)
     if n == 0:
         nrm[:] = [1.0, 1.0, 0.0, 1.0, 1.0, 0.0]
@@ -453,8 +458,6 @@ def run(kernel: Callable, wi: np.ndarray, wo: np.ndarray, p: np.ndarray, c: np.n
         return nrm
     from .evaluate import UNIT_TOL
 
-    if soa and not runs_soa(n, p):  # pragma: no cover - a caller's error
-        raise ValueError("driver.run: soa=True needs more than CHUNK pairs and no table in p")
     choices = tuple(int(v) for v in c)
     drive = special_driver_for(kernel, choices, f32, soa)
     key = _special_key(kernel, choices, f32, soa)
