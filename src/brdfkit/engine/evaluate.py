@@ -92,6 +92,13 @@ def check_unit_flat(name: str, fi: np.ndarray, fo: np.ndarray, dtype) -> None:
     check_unit(name, "wo", *_length_stats_np(fo), dtype)
 
 
+def check_driver_stats(name: str, nrm: np.ndarray, dtype) -> None:
+    """The unit-direction check from the compiled driver's per-chunk squared-length statistics
+    (``(nchunks, 6)``: wi min, max, NaN count, wo min, max, NaN count; :func:`brdfkit.engine.driver.run`)."""
+    check_unit(name, "wi", math.sqrt(nrm[:, 0].min()), math.sqrt(nrm[:, 1].max()), int(nrm[:, 2].sum()), dtype)
+    check_unit(name, "wo", math.sqrt(nrm[:, 3].min()), math.sqrt(nrm[:, 4].max()), int(nrm[:, 5].sum()), dtype)
+
+
 def run_kernel(model, kernel, args, fi: np.ndarray, fo: np.ndarray, fout: np.ndarray) -> np.ndarray | None:
     """``kernel`` with ``args = (p, c)`` on flat directions into the flat ``fout``, by the active engine.
 
@@ -135,8 +142,7 @@ def evaluate(model, wi, wo) -> np.ndarray:
             out = np.empty(wi.shape, dtype=wi.dtype, order="F")
             nrm = driver.run(kernel, wi, wo, args[0], args[1], out,
                              f32=getattr(type(model), "kernel_float32", False), soa=True)
-            check_unit(name, "wi", math.sqrt(nrm[:, 0].min()), math.sqrt(nrm[:, 1].max()), int(nrm[:, 2].sum()), wi.dtype)
-            check_unit(name, "wo", math.sqrt(nrm[:, 3].min()), math.sqrt(nrm[:, 4].max()), int(nrm[:, 5].sum()), wi.dtype)
+            check_driver_stats(name, nrm, wi.dtype)
             return out
     fi, fo, shape, dtype = prepare(name, wi, wo)
     if args is not None:
@@ -148,8 +154,7 @@ def evaluate(model, wi, wo) -> np.ndarray:
             check_unit_flat(name, fi, fo, dtype)
         nrm = run_kernel(model, kernel, args, fi, fo, fout)
         if nrm is not None:
-            check_unit(name, "wi", math.sqrt(nrm[:, 0].min()), math.sqrt(nrm[:, 1].max()), int(nrm[:, 2].sum()), dtype)
-            check_unit(name, "wo", math.sqrt(nrm[:, 3].min()), math.sqrt(nrm[:, 4].max()), int(nrm[:, 5].sum()), dtype)
+            check_driver_stats(name, nrm, dtype)
         return out
     check_unit_flat(name, fi, fo, dtype)
     return _fallback(model, fi.reshape(shape), fo.reshape(shape), dtype)
