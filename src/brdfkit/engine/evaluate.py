@@ -99,17 +99,19 @@ def check_driver_stats(name: str, nrm: np.ndarray, dtype) -> None:
     check_unit(name, "wo", math.sqrt(nrm[:, 3].min()), math.sqrt(nrm[:, 4].max()), int(nrm[:, 5].sum()), dtype)
 
 
-def run_kernel(model, kernel, args, fi: np.ndarray, fo: np.ndarray, fout: np.ndarray) -> np.ndarray | None:
+def run_kernel(model, kernel, args, fi: np.ndarray, fo: np.ndarray, fout: np.ndarray,
+               soa: bool = False) -> np.ndarray | None:
     """``kernel`` with ``args = (p, c)`` on flat directions into the flat ``fout``, by the active engine.
 
     Returns the compiled driver's squared-length statistics (``None`` under the reference engine,
-    which evaluates without them)."""
+    which evaluates without them). ``soa``: Fortran-ordered ``(n, 3)`` arrays, for the compiled
+    engine's structure-of-arrays driver (only where :func:`brdfkit.engine.driver.runs_soa`)."""
     from . import engine
     from . import driver, reference
 
     p, c = args
     if engine() == "compiled":
-        return driver.run(kernel, fi, fo, p, c, fout, f32=getattr(type(model), "kernel_float32", False))
+        return driver.run(kernel, fi, fo, p, c, fout, f32=getattr(type(model), "kernel_float32", False), soa=soa)
     reference.run(kernel, fi, fo, p, c, fout)
     return None
 
@@ -140,9 +142,7 @@ def evaluate(model, wi, wo) -> np.ndarray:
 
         if engine() == "compiled" and driver.runs_soa(wi.shape[0], args[0]):
             out = np.empty(wi.shape, dtype=wi.dtype, order="F")
-            nrm = driver.run(kernel, wi, wo, args[0], args[1], out,
-                             f32=getattr(type(model), "kernel_float32", False), soa=True)
-            check_driver_stats(name, nrm, wi.dtype)
+            check_driver_stats(name, run_kernel(model, kernel, args, wi, wo, out, soa=True), wi.dtype)
             return out
     fi, fo, shape, dtype = prepare(name, wi, wo)
     if args is not None:
