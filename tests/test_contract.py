@@ -569,3 +569,9 @@ def test_parameter_strategy_stays_in_range_and_reaches_bounds():
     run()
     assert {0.0, 1.0} <= seen["x"]
     assert 0 < seen["s_min"] < 1e-2 and seen["s_max"] >= 1e3
+
+
+def test_hypothesis_examples_are_reproducible():
+    """conftest.py loads a derandomised profile (every run draws the same examples) unless BRDFKIT_FUZZ is set."""
+    assert settings.default.derandomize is (not _FUZZ)
+    assert settings.default.database is None or _FUZZ

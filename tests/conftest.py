@@ -1,0 +1,19 @@
+"""Test-session settings shared by every module.
+
+Hypothesis draws its examples from a seed fixed per test (``derandomize``), so every run of the
+suite tests the same cases and a failure in CI reproduces on a developer's machine; set
+``BRDFKIT_FUZZ=1`` for randomised runs (new examples each time), which is how new cases are found.
+Tests that set ``max_examples`` or ``deadline`` themselves inherit the rest from this profile.
+"""
+
+from __future__ import annotations
+
+import os
+
+from hypothesis import settings
+
+FUZZ = os.environ.get("BRDFKIT_FUZZ", "") not in ("", "0")
+
+settings.register_profile("brdfkit-ci", derandomize=True, database=None)
+settings.register_profile("brdfkit-fuzz", derandomize=False)
+settings.load_profile("brdfkit-fuzz" if FUZZ else "brdfkit-ci")
