@@ -152,9 +152,14 @@ def worker_brdfkit(n: int, calls: int, threads: int = 0) -> dict:
 
 
 # --------------------------------------------------------------------------- driver
-def newest_libllvm() -> str | None:
-    """The newest system ``libLLVM`` (Dr.Jit needs LLVM >= 16 for the ``fmaximum`` it emits; with
-    Debian 12's default LLVM 14/15 the kernel fails with "Cannot select: fmaximum")."""
+#: the oldest LLVM that compiles the ``fmaximum`` Dr.Jit 1.5 emits
+MIN_LLVM = 16
+
+
+def newest_libllvm() -> tuple[str | None, int]:
+    """The newest system ``libLLVM`` and its major version (``(None, 0)`` if none). Dr.Jit needs
+    LLVM >= :data:`MIN_LLVM` for the ``fmaximum`` it emits; with Debian 12's default LLVM 14/15
+    the kernel fails with "Cannot select: fmaximum"."""
     import glob
     import re
 
@@ -163,7 +168,7 @@ def newest_libllvm() -> str | None:
         m = re.search(r"libLLVM[-.](?:so\.)?(\d+)", os.path.basename(f))
         if m and int(m.group(1)) > best_v:
             best, best_v = f, int(m.group(1))
-    return best
+    return best, best_v
 
 
 def _run_worker(kind: str, n: int, calls: int, threads: int = 0) -> dict:
@@ -173,9 +178,11 @@ def _run_worker(kind: str, n: int, calls: int, threads: int = 0) -> dict:
     if threads:
         env["NUMBA_NUM_THREADS"] = str(threads)  # numba's pool is sized at import, in the worker
     if kind == "mitsuba" and "DRJIT_LIBLLVM_PATH" not in env:
-        lib = newest_libllvm()
-        if lib:
-            env["DRJIT_LIBLLVM_PATH"] = lib
+        lib, version = newest_libllvm()
+        if version < MIN_LLVM:  # Dr.Jit would abort inside LLVM with a page of "Cannot select" output
+            raise SystemExit(f"bench_vs_mitsuba: Mitsuba's LLVM variant needs libLLVM >= {MIN_LLVM}, the newest here is "
+                             f"{version or 'none'} (apt-get install libllvm19, or set DRJIT_LIBLLVM_PATH)")
+        env["DRJIT_LIBLLVM_PATH"] = lib
     res = subprocess.run(cmd, capture_output=True, text=True, timeout=900, env=env)
     if res.returncode != 0:
         raise SystemExit(f"bench_vs_mitsuba: {kind} worker failed:\n{res.stderr[-2000:]}")
@@ -222,7 +229,7 @@ def main(argv=None) -> int:
         "rounds": args.rounds,
         "calls_per_process": args.calls,
         "mitsuba_variant": "llvm_ad_rgb (float32)",
-        "libllvm": os.environ.get("DRJIT_LIBLLVM_PATH") or newest_libllvm(),
+        "libllvm": os.environ.get("DRJIT_LIBLLVM_PATH") or newest_libllvm()[0],
         "mitsuba_kernel_Meval_s": rate(tk),
         "mitsuba_numpy_Meval_s": rate(tn),
         "brdfkit_f32_Meval_s": rate(t32),
