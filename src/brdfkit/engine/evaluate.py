@@ -111,7 +111,8 @@ def run_kernel(model, kernel, args, fi: np.ndarray, fo: np.ndarray, fout: np.nda
 
     p, c = args
     if engine() == "compiled":
-        return driver.run(kernel, fi, fo, p, c, fout, f32=getattr(type(model), "kernel_float32", False), soa=soa)
+        return driver.run(kernel, fi, fo, p, c, fout, f32=getattr(type(model), "kernel_float32", False), soa=soa,
+                          span=getattr(type(model), "kernel_span", None))
     reference.run(kernel, fi, fo, p, c, fout)
     return None
 

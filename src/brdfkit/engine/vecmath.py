@@ -216,14 +216,21 @@ def _open_library() -> tuple[str, ctypes.CDLL] | None:
     return None
 
 
-def _cpu_features() -> set[str]:
-    import llvmlite.binding as ll
+_FEATURES: set[str] | None = None
 
-    try:
-        feats = ll.get_host_cpu_features()
-    except RuntimeError:  # pragma: no cover - LLVM cannot tell on this host
-        return set()
-    return {name for name, on in feats.items() if on}
+
+def cpu_features() -> set[str]:
+    """The host CPU's features as LLVM names them (``avx2``, ``avx512f``, ...); read once."""
+    global _FEATURES
+    if _FEATURES is None:
+        import llvmlite.binding as ll
+
+        try:
+            feats = ll.get_host_cpu_features()
+        except RuntimeError:  # pragma: no cover - LLVM cannot tell on this host
+            feats = {}
+        _FEATURES = {name for name, on in feats.items() if on}
+    return _FEATURES
 
 
 def _replace(library, edit) -> None:
@@ -275,7 +282,7 @@ def _setup() -> None:
         ll.load_library_permanently(path)  # cached drivers resolve their libmvec calls through it
     except RuntimeError:  # pragma: no cover - opened by ctypes but not by LLVM
         return
-    feats = _cpu_features()
+    feats = cpu_features()
     # one pass over what libmvec exports for this CPU: the annotations' variants (by scalar
     # symbol) and, for exp/log/pow, the renames of the vector intrinsics (by function and width)
     for ty, widths in _WIDTHS.items():
@@ -296,4 +303,5 @@ def _setup() -> None:
 
 _setup()
 
-__all__ = ["ENV_VAR", "FUNCTIONS", "SCALAR_FUNCTIONS", "annotate", "available", "compiling", "rewrite", "vector_name"]
+__all__ = ["ENV_VAR", "FUNCTIONS", "SCALAR_FUNCTIONS", "annotate", "available", "compiling", "cpu_features", "rewrite",
+           "vector_name"]
