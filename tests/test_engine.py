@@ -330,7 +330,8 @@ def test_forced_width_compile_hides_llvm_remarks_only():
 @pytest.mark.parametrize("dtype", [np.float64, np.float32])
 def test_specialised_driver_runs_serially_or_in_parallel_with_the_same_bits(name, dtype, monkeypatch):
     """A call whose estimated work is below PARALLEL_MIN_S runs the serial twin of the specialised driver
-    (no thread-pool launch); both give the same values bit for bit, and the same unit-length error."""
+    (no thread-pool launch), or of the span driver for a model with a span (HTSG); both give the same
+    values bit for bit, and the same unit-length error."""
     import math
 
     m = bk.model(name)
@@ -339,7 +340,8 @@ def test_specialised_driver_runs_serially_or_in_parallel_with_the_same_bits(name
     p, c = m.kernel_args()
     f32 = dtype == np.float32 and type(m).kernel_float32
     py = type(m).kernel.py_func
-    key = (py.__module__, py.__name__, f32, tuple(int(v) for v in c))
+    span = getattr(type(m), "kernel_span", None)
+    key = driver._span_key(span) if span is not None else (py.__module__, py.__name__, f32, tuple(int(v) for v in c))
     m.eval(wi, wo)  # loads (or compiles) the drivers; the estimate of the work starts with the next call
     calls = []
     serial = driver._SERIAL[key]
@@ -449,3 +451,38 @@ def test_the_console_script_skips_numbas_blas_probe_and_scipy_linalg_still_impor
     from brdfkit.engine import skip_blas_probe
 
     assert skip_blas_probe() is False
+
+
+def test_select_is_a_choice_in_python_and_compiled():
+    from brdfkit.engine import jit, select
+
+    @jit
+    def pick(c, a, b):
+        return select(c, a, b)
+
+    @jit
+    def pick_mixed(x):
+        return select(x > 0.0, x, 0)  # int and float: unified to float
+
+    assert pick(True, 1.5, 2.5) == 1.5 and pick(False, 1.5, 2.5) == 2.5
+    assert pick.py_func(True, 1.5, 2.5) == 1.5 and select(False, 1, 2) == 2
+    assert pick_mixed(-3.0) == 0.0 and pick_mixed(2.0) == 2.0
+    assert pick(True, 3, 4) == 3
+
+
+def test_libm_log_is_pythons_log_bit_for_bit():
+    import math
+
+    from brdfkit.engine import jit, libm_log
+    from brdfkit.engine.libm import HAVE_LOGF64
+
+    @jit
+    def logs(x, out):
+        for i in range(x.size):
+            out[i] = libm_log(x[i])
+
+    x = np.concatenate([10 ** np.random.default_rng(2).uniform(-300, 300, 20000), [1.0, 2.0, 5e-324, 1.7e308]])
+    out = np.empty_like(x)
+    logs(x, out)
+    assert HAVE_LOGF64 == (sys.platform == "linux")
+    assert all(out[i] == math.log(x[i]) for i in range(x.size))
