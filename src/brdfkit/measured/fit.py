@@ -765,32 +765,38 @@ def _jacobian(fn: "_Start", packer: "ParamPacker", const: Mapping[int, np.ndarra
 
     def jac(x: np.ndarray) -> np.ndarray:
         r0 = fn.at(x)
-        J = np.empty((r0.size, len(x)))
+        Jt = np.empty((len(x), r0.size))  # the columns as contiguous rows (J's transpose), written in place
         for i in const:
             s = packer.slots[i]
-            J[:, i] = const[i] * (s.from_x(float(x[i])) if s.log else 1.0)
+            np.multiply(const[i], s.from_x(float(x[i])) if s.log else 1.0, out=Jt[i])
         seen = {}  # slot: the residuals at its own point x + h e_i (from its group's evaluation)
         for g in groups:
             y = x.copy()
             for i in g:
                 y[i] += step(x, i)
             r = fn.evaluate(y)
-            for i in g:
+            if len(g) == 1:
+                i = g[0]
                 h = y[i] - x[i]  # the step as represented
-                if len(g) == 1:
-                    J[:, i] = (r - r0) / h
-                    seen[i] = (y, r)
-                    continue
+                np.divide(np.subtract(r, r0, out=Jt[i]), h, out=Jt[i])
+                seen[i] = (y, r)
+                continue
+            d = r - r0
+            for i in g:
+                h = y[i] - x[i]
                 c = channel[i]
-                J[:, i] = 0.0 / h  # the other channels: (r0 - r0) / h, the sign of zero included
-                J[c::3, i] = (r[c::3] - r0[c::3]) / h
+                Jt[i] = 0.0 / h  # the other channels: (r0 - r0) / h, the sign of zero included
+                np.divide(d[c::3], h, out=Jt[i, c::3])
                 own = x.copy()
                 own[i] = y[i]  # the column's own point x + h e_i
                 seen[i] = (own, _own_channel(r0, r, c))
         if fn.known:  # the basin test at every column's own point, in column order
             for i in sorted(seen):
                 fn.check(*seen[i])
-        return J
+        # handed over in C order: scipy's LSMR products and column norms would be about 20 % faster
+        # on the Fortran-ordered view Jt.T, but round differently, which moves where fits in flat
+        # valleys stop (errors change by up to ±4e-5 relative, either way)
+        return np.ascontiguousarray(Jt.T)
 
     return jac
 
