@@ -284,7 +284,16 @@ _RUN_LOCK = (contextlib.nullcontext() if _engine.THREADING_LAYER in ("tbb", "saf
 #: Its cost model picks 8 for them on this CPU (interleaved (n, 3) loads), which measured half the
 #: speed of 16 (README, "Speed"); float64 keeps the cost model's choice (16 measured slower there).
 F32_VECTOR_WIDTH = 16
+#: the (driver, argument types) of the calls made so far: a call with new argument types compiles (or loads)
+#: a specialisation, for which the driver's LLVM options must be set (:func:`_compile_key`)
 _COMPILED: set = set()
+
+
+def _compile_key(drive: Callable, pt: tuple, *arrays: np.ndarray) -> tuple:
+    """What decides the specialisation a driver call runs: numba compiles one per signature of argument types,
+    and for the flat arrays a driver takes those vary only by dtype and writability (a read-only input is
+    another array type), the tuple ``p`` by its length."""
+    return (drive, len(pt)) + tuple((a.dtype, a.flags.writeable) for a in arrays)
 
 
 @contextlib.contextmanager
@@ -519,7 +528,8 @@ def _run_span(span: Callable, wi: np.ndarray, wo: np.ndarray, p: np.ndarray, c: 
     hi2 = (1.0 + tol) * (1.0 + tol) * (1.0 - margin)
     bad = np.zeros(nrm.shape[0], dtype=np.int64)
     pt = param_tuple(p)
-    first = (drive, len(pt), out.dtype, soa) not in _COMPILED
+    ck = _compile_key(drive, pt, wi, wo)
+    first = ck not in _COMPILED
     flat = (lambda x: x.T.reshape(-1)) if soa else (lambda x: x.reshape(-1))
     cs, ps = (n, 1) if soa else (1, 3)
     lock = contextlib.nullcontext() if serial else _RUN_LOCK
@@ -528,7 +538,7 @@ def _run_span(span: Callable, wi: np.ndarray, wo: np.ndarray, p: np.ndarray, c: 
         drive(flat(wi), flat(wo), pt, c, flat(out), lim, lo2, hi2, bad, cs, ps, n)
         elapsed = time.perf_counter() - t0
     if first:
-        _COMPILED.add((drive, len(pt), out.dtype, soa))
+        _COMPILED.add(ck)
     elif n > CHUNK:
         _PAIR_COST[key] = elapsed * (1 if serial else threads) / n
     if not bad.any():
@@ -619,7 +629,8 @@ def run(kernel: Callable, wi: np.ndarray, wo: np.ndarray, p: np.ndarray, c: np.n
     hi2 = ft((1.0 + tol) * (1.0 + tol) * (1.0 - margin))
     bad = np.zeros(nrm.shape[0], dtype=np.int64)
     pt = param_tuple(p, ft)
-    first = (drive, len(pt)) not in _COMPILED  # this call may compile (or load) the driver
+    ck = _compile_key(drive, pt, wi, wo)
+    first = ck not in _COMPILED  # this call may compile (or load) a specialisation of the driver
     lock = contextlib.nullcontext() if serial else _RUN_LOCK  # a serial call launches no thread pool
     with lock, (_vector_width(F32_VECTOR_WIDTH) if f32 and first else contextlib.nullcontext()), \
             vecmath.compiling():
@@ -630,7 +641,7 @@ def run(kernel: Callable, wi: np.ndarray, wo: np.ndarray, p: np.ndarray, c: np.n
             drive(wi.reshape(-1), wo.reshape(-1), pt, out.reshape(-1), lim, lo2, hi2, bad)
         elapsed = time.perf_counter() - t0
     if first:
-        _COMPILED.add((drive, len(pt)))
+        _COMPILED.add(ck)
     else:  # one-thread seconds per pair (a parallel call's time times its threads, an upper bound)
         _PAIR_COST[key] = elapsed * (1 if serial else threads) / n
     if not bad.any():
