@@ -388,10 +388,89 @@ def test_stirling_series_continues_the_table():
     assert H.ln_fact_times_m(1e5) == H.stirling_ln_fact_times_m(1e5)
 
 
+def _mp_log_term(m, g, T):
+    """ln of the m-th term of Σ/g, (m−1) ln g − g − ln(m!·m) − T/m, in 50-digit arithmetic."""
+    with mpmath.workdps(50):
+        m, g, T = mpmath.mpf(m), mpmath.mpf(g), mpmath.mpf(T)
+        return (m - 1) * mpmath.log(g) - g - mpmath.loggamma(m + 1) - mpmath.log(m) - T / m
+
+
+def test_poisson_deviance_matches_mpmath_on_both_sides_of_its_switch():
+    rng = np.random.default_rng(11)
+    g = 10 ** rng.uniform(-4, 4.3, 3000)
+    v = np.concatenate([rng.uniform(-0.6, 0.6, 2000), rng.uniform(-0.26, 0.26, 1000)])  # v = (m − g)/(m + g)
+    m = np.maximum(np.round(g * (1 + v) / (1 - v)), 1.0)
+    worst = 0.0
+    with mpmath.workdps(50):
+        for mi, gi in zip(m, g):
+            want = mpmath.mpf(mi) * mpmath.log(mpmath.mpf(mi) / mpmath.mpf(gi)) + mpmath.mpf(gi) - mpmath.mpf(mi)
+            got = H.poisson_deviance(mi, gi)
+            worst = max(worst, abs(got - float(want)) / max(float(want), 1e-300))
+    vv = (m - g) / (m + g)
+    assert (np.abs(vv) < H.DEVIANCE_SERIES).sum() > 500 and (np.abs(vv) >= H.DEVIANCE_SERIES).sum() > 500
+    assert worst < 5e-14
+
+
+def test_stirling_remainder_matches_mpmath_below_and_above_the_table():
+    for m in list(range(1, 40)) + [100, 1000, 32767, 1e5, 1e7]:
+        with mpmath.workdps(50):
+            mm = mpmath.mpf(m)
+            want = mpmath.loggamma(mm + 1) - (mm + mpmath.mpf(0.5)) * mpmath.log(mm) + mm - mpmath.log(2 * mpmath.pi) / 2
+        assert abs(H.stirling_remainder(float(m)) - float(want)) <= 2e-16 * max(float(want), 1e-3), m
+
+
+def test_peak_term_has_no_cancellation_and_does_not_amplify_an_error_in_ln_g():
+    """The peak's log term against 50-digit arithmetic where it is a difference of numbers of ~m ln m (m up to
+    ~3e4): within 2e-14 plus 2e-15 of the value (bd0's plain form, |v| ≥ 0.25, cancels up to a factor ~5; the
+    first form, ``(m−1) ln g − g − ln(m!·m) − T/m`` in doubles, is off by up to m ln m times the rounding,
+    ~5e-11, also where the value is small); and an error of 4 ulp in ln g moves it by 4 ulp of ln g, not m
+    times."""
+    rng = np.random.default_rng(12)
+    worst = 0.0
+    for _ in range(300):
+        g = 10 ** rng.uniform(-2, 4.5)
+        T = g * 10 ** rng.uniform(-3, 2) if rng.random() < 0.8 else 0.0
+        m = max(round(g * 10 ** rng.uniform(-0.05, 0.3)), 1)
+        lg = np.log(g)
+        got = H.log_term(float(m), lg, g, T)
+        want = float(_mp_log_term(m, g, T))
+        worst = max(worst, abs(got - want) / (1.0 + abs(want) / 10.0))  # + 2e-15 of the value itself
+        moved = H.log_term(float(m), lg * (1 + 4 * 2.0**-52), g, T) - got
+        assert abs(moved) <= 4 * 2.0**-52 * abs(lg) + 4 * 2.0**-52 * max(abs(lg), abs(got), 1.0)  # + the roundings
+    assert worst < 2e-14
+
+
+def test_span_terms_sum_each_window_whatever_the_order_of_the_pairs():
+    """span_terms sorts the pairs by their counts (to 127; longer windows in any order) and stops the loop over
+    pairs where the windows have ended: each pair's sum is its own window's, in any order and with counts past
+    the sort's bins."""
+    rng = np.random.default_rng(13)
+    nb = H.SPAN_BLOCK
+    for m in (nb, 37, 1):
+        g = 10 ** rng.uniform(-1, 3, nb)
+        T = g * 10 ** rng.uniform(-2, 1, nb)
+        LG, TT, BASE, Hs, CNT, MC, LFC = (np.zeros(nb) for _ in range(7))
+        for i in range(nb):
+            mc, h, jlo, jhi, peak = H.direct_window(g[i], T[i], np.log(g[i]))
+            LG[i], TT[i], BASE[i], Hs[i], MC[i] = np.log(g[i]), T[i], mc + jlo * h, h, mc
+            CNT[i], LFC[i] = jhi - jlo + 1, H.ln_fact_times_m(mc)
+        CNT[:3] = [200.0, 150.0, 0.0]  # past SORT_BINS, and an empty window
+        BASE[:2] = np.maximum(MC[:2] - 20 * Hs[:2], 1.0)
+        ACC = np.zeros(nb)
+        H.span_terms(LG, TT, BASE, Hs, CNT, MC, LFC, ACC, m, np.empty((8, nb)), np.empty(nb, np.int64),
+                     np.empty(H.SORT_BINS, np.int64))
+        for i in range(nb):
+            mm = BASE[i] + Hs[i] * np.arange(CNT[i] if i < m else 0)
+            lf = np.array([H.ln_fact_times_m(x) for x in mm])
+            want = np.exp((mm - MC[i]) * (LG[i] + TT[i] / (mm * MC[i])) - (lf - LFC[i])).sum()
+            assert ACC[i] == pytest.approx(want, rel=1e-13, abs=0.0)
+
+
 def test_compiled_span_keeps_parity_where_the_tail_is_ill_conditioned():
-    """Far in the tail (rough, short wavelength) the value's relative error is ~m times g's; with the effective
-    roughness and ln g from the vector math library the engines differed by 1.4e-11 here; from glibc's scalar
-    functions (as now) they agree to 1e-12."""
+    """Far in the tail (rough, short wavelength) the terms have m up to ~1e4: the compiled span (the vector math
+    library's functions, 4 ulp) agrees with the reference engine (glibc's scalar ones) to 1e-12 there, as the
+    peak's term is computed without cancellation (:func:`log_term`); with ``(m−1) ln g − g − ln(m!·m)`` and
+    the vector library's ln g, they differed by 1.4e-11 here."""
     from brdfkit import engine
     from brdfkit.geometry import random_unit_vectors
 

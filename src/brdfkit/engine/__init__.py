@@ -206,7 +206,5 @@ _sys.modules[__name__].__class__ = _CallableModule
 from .cache import jit, vectorize  # noqa: E402
 from .evaluate import evaluate, check_unit  # noqa: E402
 from .select import select  # noqa: E402
-from .libm import libm_log  # noqa: E402
 
-__all__ = ["ENGINES", "ENV_VAR", "set_engine", "engine", "jit", "vectorize", "evaluate", "check_unit", "select",
-           "libm_log"]
+__all__ = ["ENGINES", "ENV_VAR", "set_engine", "engine", "jit", "vectorize", "evaluate", "check_unit", "select"]
