@@ -326,6 +326,34 @@ def test_forced_width_compile_hides_llvm_remarks_only():
     assert out.stderr.splitlines() == ["a real warning", "after"]
 
 
+def test_compile_options_are_set_only_under_numbas_compiler_lock():
+    """A driver's first call sets LLVM's process-wide options (vector width, unroll threshold) only while it
+    holds numba's compiler lock: a compile on another thread (which holds that lock) never sees them change
+    under it, and this call's compile never runs with another thread's. Here a thread holds the lock; the
+    options context waits until it is released."""
+    import threading
+    import time
+
+    from numba.core.compiler_lock import global_compiler_lock
+
+    held, entered = threading.Event(), []
+
+    def holder():
+        with global_compiler_lock:
+            held.set()
+            time.sleep(0.3)
+            entered.append(("holder releases", time.perf_counter()))
+
+    t = threading.Thread(target=holder)
+    t.start()
+    held.wait()
+    with driver._compile_options(8, driver.SPAN_UNROLL_THRESHOLD):
+        entered.append(("options set", time.perf_counter()))
+        assert global_compiler_lock.is_locked()
+    t.join()
+    assert [e[0] for e in entered] == ["holder releases", "options set"]
+
+
 @pytest.mark.parametrize("name", ["microfacet", "htsg"])
 @pytest.mark.parametrize("dtype", [np.float64, np.float32])
 def test_specialised_driver_runs_serially_or_in_parallel_with_the_same_bits(name, dtype, monkeypatch):

@@ -35,7 +35,8 @@ vectorised across pairs that way; such a model may also give a *span* (``kernel_
 scalar functions composed over a block of pairs, loop by loop, so that each loop vectorises across
 pairs. Its calls run :data:`SPAN_TEMPLATE` (:func:`run` with ``span``): the unit check, then the
 span, chunk by chunk, in parallel or serially as above, on rows or Fortran-ordered arrays alike (the
-span takes the component and pair strides). The reference engine runs the per-pair kernel.
+span takes the component and pair strides); calls of at most :data:`SPAN_MIN_PAIRS` pairs run the per-pair
+kernel, which starts faster. The reference engine runs the per-pair kernel.
 """
 
 from __future__ import annotations
@@ -296,41 +297,36 @@ def _compile_key(drive: Callable, pt: tuple, *arrays: np.ndarray) -> tuple:
     return (drive, len(pt)) + tuple((a.dtype, a.flags.writeable) for a in arrays)
 
 
-@contextlib.contextmanager
-def _vector_width(width: int):
-    """LLVM's ``-force-vector-width`` while a driver compiles (a process-wide LLVM option: set, then reset to 0,
-    LLVM's default, "the cost model decides"). A numba compile elsewhere at the same moment would see it
-    too; that changes its speed, never its results."""
-    import llvmlite.binding as ll
-
-    ll.set_option("", f"-force-vector-width={width}")
-    try:
-        with _without_llvm_remarks():
-            yield
-    finally:
-        ll.set_option("", "-force-vector-width=0")
-
-
 #: LLVM's loop-unroll threshold while a span driver compiles: a span's loops over pairs vectorise only
 #: once the small loops of constant length inside them (HTSG's asymptotic series, 6 × up to 8 terms)
 #: are fully unrolled, which LLVM's default threshold (300 at -O3) does not do
 SPAN_UNROLL_THRESHOLD = 1000
-#: LLVM's own value of that threshold at numba's -O3, restored afterwards
+#: LLVM's own value of that threshold at numba's -O3, set for every other driver
 LLVM_UNROLL_THRESHOLD = 300
 
 
 @contextlib.contextmanager
-def _span_options(width: int):
-    """LLVM options while a span driver compiles: ``-unroll-threshold`` (:data:`SPAN_UNROLL_THRESHOLD`) and,
-    if ``width``, ``-force-vector-width``; process-wide like :func:`_vector_width`, then reset to LLVM's values."""
+def _compile_options(width: int = 0, unroll: int = LLVM_UNROLL_THRESHOLD):
+    """LLVM's options for a driver call that may compile: ``-force-vector-width`` (0: the cost model's choice)
+    and ``-unroll-threshold``. They are process-wide, so they are set while holding numba's compiler lock,
+    which every numba compile takes, and reset to LLVM's values before it is released: no compile on
+    another thread runs with this call's options, nor this one with another's. (Set outside the lock, a
+    compile waiting for it ran with the options another thread had set meanwhile, or with the defaults
+    another thread's reset had restored, and was cached so: the serial and parallel HTSG span drivers then
+    vectorised differently and differed in the last bit in full test runs.) The call runs under the lock
+    too (a driver compiles on its first call); only first calls come here."""
     import llvmlite.binding as ll
+    from numba.core.compiler_lock import global_compiler_lock
 
-    ll.set_option("", f"-unroll-threshold={SPAN_UNROLL_THRESHOLD}")
-    try:
-        with (_vector_width(width) if width else _without_llvm_remarks()):
-            yield
-    finally:
-        ll.set_option("", f"-unroll-threshold={LLVM_UNROLL_THRESHOLD}")
+    with global_compiler_lock:
+        ll.set_option("", f"-unroll-threshold={unroll}")
+        ll.set_option("", f"-force-vector-width={width}")
+        try:
+            with (_without_llvm_remarks() if width else contextlib.nullcontext()):
+                yield
+        finally:
+            ll.set_option("", "-force-vector-width=0")
+            ll.set_option("", f"-unroll-threshold={LLVM_UNROLL_THRESHOLD}")
 
 
 @contextlib.contextmanager
@@ -507,6 +503,13 @@ def span_driver_for(span: Callable) -> Callable:
     return _load(key, _stem(py) + "__span", src)
 
 
+#: a call of at most this many pairs runs a span model's per-pair kernel (the generic driver), not its span:
+#: a span call costs ~25 µs more before its first pair (its scratch, its Python), the per-pair kernel ~1.8 µs
+#: per pair more after it (HTSG, measured: 5 against 32 µs for one pair, 18 against 30 for 8, 75 against 56
+#: for 32). Both compute the same functions; the values differ by the vector math library's rounding (1e-13).
+SPAN_MIN_PAIRS = 16
+
+
 def _run_span(span: Callable, wi: np.ndarray, wo: np.ndarray, p: np.ndarray, c: np.ndarray, out: np.ndarray,
               soa: bool) -> np.ndarray:
     """:func:`run` for a model with a span: float64 computation on rows or Fortran-ordered arrays."""
@@ -533,7 +536,8 @@ def _run_span(span: Callable, wi: np.ndarray, wo: np.ndarray, p: np.ndarray, c: 
     flat = (lambda x: x.T.reshape(-1)) if soa else (lambda x: x.reshape(-1))
     cs, ps = (n, 1) if soa else (1, 3)
     lock = contextlib.nullcontext() if serial else _RUN_LOCK
-    with lock, (_span_options(_span_width()) if first else contextlib.nullcontext()), vecmath.compiling():
+    with lock, (_compile_options(_span_width(), SPAN_UNROLL_THRESHOLD) if first else contextlib.nullcontext()), \
+            vecmath.compiling():
         t0 = time.perf_counter()
         drive(flat(wi), flat(wo), pt, c, flat(out), lim, lo2, hi2, bad, cs, ps, n)
         elapsed = time.perf_counter() - t0
@@ -579,7 +583,7 @@ def run(kernel: Callable, wi: np.ndarray, wo: np.ndarray, p: np.ndarray, c: np.n
     :func:`runs_soa`): ``wi``, ``wo`` and ``out`` are Fortran-ordered ``(n, 3)`` arrays, read and
     written in place by the structure-of-arrays driver (the same values: float64 bit for bit, float32
     to the rounding of its fused multiply-adds). ``span``: the model's span (module docstring), which
-    then runs instead of ``kernel`` for every call, in float64.
+    then runs instead of ``kernel`` for every call of more than :data:`SPAN_MIN_PAIRS` pairs, in float64.
     """
     n = wi.shape[0]
     if soa and not runs_soa(n, p):
@@ -589,7 +593,7 @@ def run(kernel: Callable, wi: np.ndarray, wo: np.ndarray, p: np.ndarray, c: np.n
     if n == 0:
         nrm[:] = [1.0, 1.0, 0.0, 1.0, 1.0, 0.0]
         return nrm
-    if span is not None:
+    if span is not None and n > SPAN_MIN_PAIRS:
         return _run_span(span, wi, wo, p, c, out, soa)
     if f32 and out.dtype == np.float32:
         from .precision import fits_float32
@@ -632,7 +636,7 @@ def run(kernel: Callable, wi: np.ndarray, wo: np.ndarray, p: np.ndarray, c: np.n
     ck = _compile_key(drive, pt, wi, wo)
     first = ck not in _COMPILED  # this call may compile (or load) a specialisation of the driver
     lock = contextlib.nullcontext() if serial else _RUN_LOCK  # a serial call launches no thread pool
-    with lock, (_vector_width(F32_VECTOR_WIDTH) if f32 and first else contextlib.nullcontext()), \
+    with lock, (_compile_options(F32_VECTOR_WIDTH if f32 else 0) if first else contextlib.nullcontext()), \
             vecmath.compiling():
         t0 = time.perf_counter()
         if soa:  # the transposes of Fortran-ordered (n, 3) arrays are C-contiguous: flat views, no copy
