@@ -499,3 +499,22 @@ def test_eval_runs_the_span_driver():
     rng = np.random.default_rng(1)
     m.eval(random_unit_vectors(50, rng), random_unit_vectors(50, rng))
     assert driver._span_key(H.htsg_span) in driver._DRIVERS
+
+
+def test_small_calls_run_the_per_pair_kernel_with_the_spans_values():
+    """At most SPAN_MIN_PAIRS pairs run the per-pair kernel (it starts ~25 µs sooner); the values agree with the
+    span's to the vector math library's rounding."""
+    from brdfkit.engine import driver
+    from brdfkit.geometry import random_unit_vectors
+
+    m = bk.model("htsg", sigma0=0.6, tau=2.0)
+    rng = np.random.default_rng(14)
+    wi, wo = random_unit_vectors(400, rng), random_unit_vectors(400, rng)
+    big = m.eval(wi, wo)
+    k = driver.SPAN_MIN_PAIRS
+    small = np.concatenate([m.eval(wi[i:i + k], wo[i:i + k]) for i in range(0, 400, k)])
+    one = m.eval(wi[7], wo[7])
+    nz = big > 1e-300
+    assert nz.sum() > 500
+    np.testing.assert_allclose(small[nz], big[nz], rtol=1e-12, atol=0)
+    np.testing.assert_allclose(one, big[7], rtol=1e-12, atol=0)

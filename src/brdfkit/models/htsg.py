@@ -796,12 +796,12 @@ def htsg_span(a, b, o, cs, ps, lo, hi, p, c, lim):
     cs = n, ps = 1); the result is 0 where ``wi.z <= 0`` or ``wo.z <= 0`` and at most ``lim``. Block by
     block of :data:`SPAN_BLOCK` pairs, each step a loop over the block's pairs: (1) the geometry, the
     effective roughness, :func:`span_channel` and :func:`span_window` per channel; (2) :func:`span_terms`;
-    (3) :func:`span_value`. The three channels are written out in step 1 (a loop over them would be the
-    innermost loop, and LLVM vectorises only that one). Per pair the numbers are those of
-    :func:`htsg_kernel` up to the rounding of the vector math library (4 ulp, glibc's libmvec), which
-    the forms of :func:`log_term` and :func:`term_rel` do not amplify (tested against the reference engine,
-    which runs :func:`htsg_kernel`, to 1e-12 or the value's own sensitivity to a few ulp of σ0 where that
-    is larger: far in the tail, where the terms have large m).
+    (3) :func:`span_value` into scratch, then the strided stores (LLVM leaves a loop that writes to ``o``
+    scalar: ``o`` may alias the directions). The three channels are written out in step 1, whose body is
+    large (LLVM unrolls only small loops such as step 3's before it vectorises the loop around them). Per
+    pair the numbers are those of :func:`htsg_kernel` up to the rounding of the vector math library (4 ulp,
+    glibc's libmvec), which the forms of :func:`log_term` and :func:`term_rel` do not amplify (tested
+    against the reference engine, which runs :func:`htsg_kernel`, to 1e-12, far in the tail included).
     """
     sigma0 = p[0]
     tau = p[1]
