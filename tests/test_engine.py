@@ -496,3 +496,43 @@ def test_select_is_a_choice_in_python_and_compiled():
     assert pick.py_func(True, 1.5, 2.5) == 1.5 and select(False, 1, 2) == 2
     assert pick_mixed(-3.0) == 0.0 and pick_mixed(2.0) == 2.0
     assert pick(True, 3, 4) == 3
+
+
+@pytest.mark.parametrize("n", [100, 3 * driver.CHUNK])
+def test_writable_and_read_only_inputs_share_one_specialisation(n):
+    """numba types a read-only array apart from a writable one; the driver passes every input read-only, so a
+    frozen array (the albedo plan's) and a writable one run the same compiled code (one compile, one cache
+    entry, one load per process) and give the same bits."""
+    m = bk.model("microfacet", distribution="beckmann", fresnel="schlick", alpha=0.37)
+    rng = np.random.default_rng(5)
+    wi, wo = random_unit_vectors(n, rng), random_unit_vectors(n, rng)
+    frozen_i, frozen_o = wi.copy(), wo.copy()
+    frozen_i.setflags(write=False)
+    frozen_o.setflags(write=False)
+    seen = []
+    real = driver._compile_key
+
+    def spy(drive, pt, *arrays):
+        seen.append(tuple(a.flags.writeable for a in arrays))
+        return real(drive, pt, *arrays)
+
+    driver._compile_key = spy
+    try:
+        a = m.eval(wi, wo)
+        b = m.eval(frozen_i, wo)
+        c = m.eval(frozen_i, frozen_o)
+    finally:
+        driver._compile_key = real
+    np.testing.assert_array_equal(a, b)
+    np.testing.assert_array_equal(a, c)
+    assert wi.flags.writeable and wo.flags.writeable  # the caller's arrays are untouched
+    assert all(not any(w) for w in seen)
+    if n > driver.CHUNK:
+        assert len(seen) == 3
+        kernel = type(m).kernel
+        choices = tuple(int(v) for v in m.kernel_args()[1])
+        drive = driver.special_driver_for(kernel, choices, False, False)
+        assert len(drive.signatures) == 1, drive.signatures
+    else:
+        gd = driver.driver_for(type(m).kernel, False)._drive
+        assert gd.signatures and all(not any(a.mutable for a in sig[:4]) for sig in gd.signatures), gd.signatures

@@ -569,6 +569,21 @@ def param_tuple(p: np.ndarray, ft=np.float64) -> tuple[float, ...]:
     return tuple(p.tolist()) + (0.0,) * (size - n)
 
 
+def read_only(a: np.ndarray) -> np.ndarray:
+    """``a``, or a read-only view of it (no copy).
+
+    numba specialises a function on each array argument's writability too, so a frozen array (the
+    albedo plan's, :mod:`brdfkit.analysis.albedo`) and a writable one would each compile, cache and,
+    in every new process, load their own copy of a driver: half of ``check --all``'s cache loads were
+    such twins. :func:`run` passes every input array read-only, so each driver has one.
+    """
+    if not a.flags.writeable:
+        return a
+    v = a.view()
+    v.flags.writeable = False
+    return v
+
+
 def run(kernel: Callable, wi: np.ndarray, wo: np.ndarray, p: np.ndarray, c: np.ndarray, out: np.ndarray,
         f32: bool = False, soa: bool = False, span: Callable | None = None) -> np.ndarray:
     """Evaluate ``kernel`` into ``out`` (flat ``(n, 3)``); returns the ``(nchunks, 6)`` squared-length statistics.
@@ -586,6 +601,7 @@ def run(kernel: Callable, wi: np.ndarray, wo: np.ndarray, p: np.ndarray, c: np.n
     then runs instead of ``kernel`` for every call of more than :data:`SPAN_MIN_PAIRS` pairs, in float64.
     """
     n = wi.shape[0]
+    wi, wo, p, c = read_only(wi), read_only(wo), read_only(p), read_only(c)  # one specialisation per driver
     if soa and not runs_soa(n, p):
         raise ValueError(f"driver.run: soa=True needs more than {CHUNK} pairs and no table in p (got {n} pairs, "
                          f"{len(p)} parameters)")
@@ -604,7 +620,7 @@ def run(kernel: Callable, wi: np.ndarray, wo: np.ndarray, p: np.ndarray, c: np.n
     ft = np.float32 if f32 else np.float64
     lim = ft(np.finfo(out.dtype).max)
     if f32:
-        p = p.astype(np.float32)
+        p = read_only(p.astype(np.float32))
     if n <= CHUNK:  # a single chunk runs inline, no thread pool: no lock needed
         gd = driver_for(kernel, f32)._drive
         with vecmath.compiling():  # a compile meanwhile calls libmvec (.vecmath)
@@ -657,4 +673,4 @@ def run(kernel: Callable, wi: np.ndarray, wo: np.ndarray, p: np.ndarray, c: np.n
 
 __all__ = ["CHUNK", "PARALLEL_MIN_S", "TEMPLATE", "SPECIAL_TEMPLATE", "SOA_TEMPLATE", "SPAN_TEMPLATE", "driver_for",
            "special_driver_for", "span_driver_for",
-           "param_tuple", "run", "runs_soa", "nchunks"]
+           "param_tuple", "read_only", "run", "runs_soa", "nchunks"]
