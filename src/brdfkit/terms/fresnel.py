@@ -92,16 +92,12 @@ def f_conductor(c, eta, k):
     t = (m1 + 1.0) * c + u
     w = Q * c + v
     dp = t * t + w * w  # |η² c + g|²
-    sp = ds * dp  # <= 2.2e8 for the parameters' ranges; 0 only where |η² − 1| is 0 or its square underflows
-    if sp == 0.0:
+    if ds == 0.0 or dp == 0.0:
         return 0.0
-    # |r_s| = qa/ds and |r_p|/|b| = qa/dp from one quotient qa/(ds·dp): one division, not two (a
-    # division costs as much as ~4 products in a vectorised kernel; the three channels had six)
-    r = qa / sp
-    rs = r * dp
-    qp = r * ds
+    rs = qa / ds
     br = (m1 + 2.0) * c2 - 1.0  # Re((η² + 1) c² − 1)
     bi = Q * c2
+    qp = qa / dp
     F = 0.5 * (rs * rs + qp * qp * (br * br + bi * bi))  # |r_p|² without the modulus's sqrt
     return min(max(F, 0.0), 1.0)
 
