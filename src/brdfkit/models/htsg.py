@@ -724,7 +724,11 @@ SPAN_LANES = SPAN_VECTOR_WIDTH
 SORT_BINS = 128
 
 
-@jit
+# inlined (numba IR) into htsg_span, which only a span driver compiles (under its LLVM options): as a function of
+# its own its code was disk-cached by whichever process compiled it first, with or without those options (a
+# direct call compiles it without), and then linked into span drivers compiled later (a suspected cause of the
+# serial and parallel span drivers' last-bit differences, tests/test_engine.py)
+@jit(inline=True)
 def span_terms(LG, TT, BASE, H, CNT, MC, LFC, ACC, m, S, order, bins):
     """Sum the windows' terms of one channel into ``ACC[:m]``, the t-th term of the block's ``m`` pairs at once
     (:func:`htsg_span`, step 2), each pair's in the order of :func:`direct_sum`.
