@@ -291,10 +291,10 @@ _COMPILED: set = set()
 
 
 def _compile_key(drive: Callable, pt: tuple, *arrays: np.ndarray) -> tuple:
-    """What decides the specialisation a driver call runs: numba compiles one per signature of argument types,
-    and for the flat arrays a driver takes those vary only by dtype and writability (a read-only input is
-    another array type), the tuple ``p`` by its length."""
-    return (drive, len(pt)) + tuple((a.dtype, a.flags.writeable) for a in arrays)
+    """What decides the specialisation a driver call runs: numba compiles one per signature of argument types;
+    the flat input arrays :func:`run` passes are always read-only (:func:`read_only`), so those vary only by
+    dtype, the tuple ``p`` by its length."""
+    return (drive, len(pt)) + tuple(a.dtype for a in arrays)
 
 
 #: LLVM's loop-unroll threshold while a span driver compiles: a span's loops over pairs vectorise only
@@ -503,6 +503,46 @@ def span_driver_for(span: Callable) -> Callable:
     return _load(key, _stem(py) + "__span", src)
 
 
+#: the squared-length statistics of a call whose every direction is within the unit tolerance
+_ALL_UNIT = (1.0, 1.0, 0.0, 1.0, 1.0, 0.0)
+
+
+def _serially(key: tuple, n: int) -> tuple[bool, int]:
+    """``(serial, threads)``: whether a call of ``n`` pairs runs the serial twin of the driver ``key`` (one
+    numba thread, or work estimated from its earlier calls below :data:`PARALLEL_MIN_S`)."""
+    threads = numba.get_num_threads()
+    cost = _PAIR_COST.get(key)
+    return threads == 1 or (cost is not None and n * cost < PARALLEL_MIN_S), threads
+
+
+def _unit_band(dtype, ft) -> tuple:
+    """``(lo2, hi2)``: a band of squared lengths safely inside ``|w|`` in ``[1 − tol, 1 + tol]`` (``tol`` the
+    unit tolerance of the output ``dtype``), in the working precision ``ft``: the margin is far above the
+    rounding of x² + y² + z² in that precision (and of the band's own rounding to it)."""
+    from .evaluate import UNIT_TOL
+
+    tol = UNIT_TOL[dtype]
+    margin = 1e-5 if ft is np.float32 else 1e-9
+    return ft((1.0 - tol) * (1.0 - tol) * (1.0 + margin)), ft((1.0 + tol) * (1.0 + tol) * (1.0 - margin))
+
+
+def _after_call(key: tuple, ck: tuple, first: bool, elapsed: float, serial: bool, threads: int, n: int,
+                bad: np.ndarray, wi: np.ndarray, wo: np.ndarray, nrm: np.ndarray) -> np.ndarray:
+    """The bookkeeping after a specialised or span driver's call: the compiled specialisation noted, or the
+    driver's one-thread seconds per pair (a parallel call's time times its threads, an upper bound; calls of
+    more than :data:`CHUNK` pairs), and ``nrm`` filled: all within tolerance, or the exact statistics (the
+    generic driver's formula) for ``check_unit`` and its message."""
+    if first:
+        _COMPILED.add(ck)
+    elif n > CHUNK:
+        _PAIR_COST[key] = elapsed * (1 if serial else threads) / n
+    if not bad.any():
+        nrm[:] = _ALL_UNIT
+    else:
+        nrm[:] = [*_sq_stats(np.ascontiguousarray(wi)), *_sq_stats(np.ascontiguousarray(wo))]
+    return nrm
+
+
 #: a call of at most this many pairs runs a span model's per-pair kernel (the generic driver), not its span:
 #: a span call costs ~25 µs more before its first pair (its scratch, its Python), the per-pair kernel ~1.8 µs
 #: per pair more after it (HTSG, measured: 5 against 32 µs for one pair, 18 against 30 for 8, 75 against 56
@@ -513,22 +553,16 @@ SPAN_MIN_PAIRS = 16
 def _run_span(span: Callable, wi: np.ndarray, wo: np.ndarray, p: np.ndarray, c: np.ndarray, out: np.ndarray,
               soa: bool) -> np.ndarray:
     """:func:`run` for a model with a span: float64 computation on rows or Fortran-ordered arrays."""
-    from .evaluate import UNIT_TOL
-
     n = wi.shape[0]
     nrm = np.empty((nchunks(n), 6), dtype=np.float64)
     drive = span_driver_for(span)
     key = _span_key(span)
-    threads = numba.get_num_threads()
-    cost = _PAIR_COST.get(key)
-    serial = threads == 1 or n <= CHUNK or (cost is not None and n * cost < PARALLEL_MIN_S)
+    serial, threads = _serially(key, n)
+    serial = serial or n <= CHUNK
     if serial:
         drive = _SERIAL[key]
     lim = np.float64(np.finfo(out.dtype).max)
-    tol = UNIT_TOL[out.dtype]
-    margin = 1e-9 if out.dtype == np.float64 else 1e-5
-    lo2 = (1.0 - tol) * (1.0 - tol) * (1.0 + margin)
-    hi2 = (1.0 + tol) * (1.0 + tol) * (1.0 - margin)
+    lo2, hi2 = _unit_band(out.dtype, np.float64)
     bad = np.zeros(nrm.shape[0], dtype=np.int64)
     pt = param_tuple(p)
     ck = _compile_key(drive, pt, wi, wo)
@@ -541,15 +575,7 @@ def _run_span(span: Callable, wi: np.ndarray, wo: np.ndarray, p: np.ndarray, c: 
         t0 = time.perf_counter()
         drive(flat(wi), flat(wo), pt, c, flat(out), lim, lo2, hi2, bad, cs, ps, n)
         elapsed = time.perf_counter() - t0
-    if first:
-        _COMPILED.add(ck)
-    elif n > CHUNK:
-        _PAIR_COST[key] = elapsed * (1 if serial else threads) / n
-    if not bad.any():
-        nrm[:] = [1.0, 1.0, 0.0, 1.0, 1.0, 0.0]
-    else:
-        nrm[:] = [*_sq_stats(np.ascontiguousarray(wi)), *_sq_stats(np.ascontiguousarray(wo))]
-    return nrm
+    return _after_call(key, ck, first, elapsed, serial, threads, n, bad, wi, wo, nrm)
 
 
 def runs_soa(n: int, p: np.ndarray) -> bool:
@@ -607,7 +633,7 @@ def run(kernel: Callable, wi: np.ndarray, wo: np.ndarray, p: np.ndarray, c: np.n
                          f"{len(p)} parameters)")
     nrm = np.empty((nchunks(n), 6), dtype=np.float64)
     if n == 0:
-        nrm[:] = [1.0, 1.0, 0.0, 1.0, 1.0, 0.0]
+        nrm[:] = _ALL_UNIT
         return nrm
     if span is not None and n > SPAN_MIN_PAIRS:
         return _run_span(span, wi, wo, p, c, out, soa)
@@ -631,22 +657,13 @@ def run(kernel: Callable, wi: np.ndarray, wo: np.ndarray, p: np.ndarray, c: np.n
         with _RUN_LOCK, vecmath.compiling():
             gd(wi, wo, p, c, out, lim, nrm)
         return nrm
-    from .evaluate import UNIT_TOL
-
     choices = tuple(int(v) for v in c)
     drive = special_driver_for(kernel, choices, f32, soa)
     key = _special_key(kernel, choices, f32, soa)
-    threads = numba.get_num_threads()
-    cost = _PAIR_COST.get(key)
-    serial = threads == 1 or (cost is not None and n * cost < PARALLEL_MIN_S)
+    serial, threads = _serially(key, n)
     if serial:
         drive = _SERIAL[key]
-    tol = UNIT_TOL[out.dtype]
-    # a band of squared lengths safely inside |w| in [1 - tol, 1 + tol]: the margin is far above the
-    # rounding of x² + y² + z² in the working precision (and of the band's own rounding to it)
-    margin = 1e-5 if f32 else 1e-9
-    lo2 = ft((1.0 - tol) * (1.0 - tol) * (1.0 + margin))
-    hi2 = ft((1.0 + tol) * (1.0 + tol) * (1.0 - margin))
+    lo2, hi2 = _unit_band(out.dtype, ft)
     bad = np.zeros(nrm.shape[0], dtype=np.int64)
     pt = param_tuple(p, ft)
     ck = _compile_key(drive, pt, wi, wo)
@@ -660,15 +677,7 @@ def run(kernel: Callable, wi: np.ndarray, wo: np.ndarray, p: np.ndarray, c: np.n
         else:
             drive(wi.reshape(-1), wo.reshape(-1), pt, out.reshape(-1), lim, lo2, hi2, bad)
         elapsed = time.perf_counter() - t0
-    if first:
-        _COMPILED.add(ck)
-    else:  # one-thread seconds per pair (a parallel call's time times its threads, an upper bound)
-        _PAIR_COST[key] = elapsed * (1 if serial else threads) / n
-    if not bad.any():
-        nrm[:] = [1.0, 1.0, 0.0, 1.0, 1.0, 0.0]  # every length within tolerance
-    else:  # exact statistics (same formula as the generic driver), for check_unit and its message
-        nrm[:] = [*_sq_stats(np.ascontiguousarray(wi)), *_sq_stats(np.ascontiguousarray(wo))]
-    return nrm
+    return _after_call(key, ck, first, elapsed, serial, threads, n, bad, wi, wo, nrm)
 
 
 __all__ = ["CHUNK", "PARALLEL_MIN_S", "TEMPLATE", "SPECIAL_TEMPLATE", "SOA_TEMPLATE", "SPAN_TEMPLATE", "driver_for",
