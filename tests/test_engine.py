@@ -347,7 +347,7 @@ def test_compile_options_are_set_only_under_numbas_compiler_lock():
     t = threading.Thread(target=holder)
     t.start()
     held.wait()
-    with driver._compile_options(8, driver.SPAN_UNROLL_THRESHOLD):
+    with driver._compile_options(8, driver.SPAN_UNROLL_THRESHOLD, interleave=2):
         entered.append(("options set", time.perf_counter()))
         assert global_compiler_lock.is_locked()
     t.join()
