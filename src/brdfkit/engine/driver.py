@@ -494,14 +494,10 @@ def special_driver_for(kernel: Callable, choices: tuple[int, ...], f32: bool = F
 SPAN_VECTOR_WIDTH = 8
 
 
-def _span_width() -> int:
-    """:data:`SPAN_VECTOR_WIDTH` on a CPU with AVX-512, else 0 (the cost model's choice)."""
-    return SPAN_VECTOR_WIDTH if "avx512f" in vecmath.cpu_features() else 0
-
-
-def _special_interleave() -> int:
-    """:data:`SPECIAL_INTERLEAVE` on a CPU with AVX-512, else 0 (the cost model's choice)."""
-    return SPECIAL_INTERLEAVE if "avx512f" in vecmath.cpu_features() else 0
+def _on_avx512(option: int) -> int:
+    """An LLVM option's value measured on AVX-512 (:data:`SPAN_VECTOR_WIDTH`, :data:`SPECIAL_INTERLEAVE`):
+    ``option`` on a CPU with AVX-512, else 0 (the cost model's choice)."""
+    return option if "avx512f" in vecmath.cpu_features() else 0
 
 
 def _span_key(span: Callable) -> tuple:
@@ -588,7 +584,7 @@ def _run_span(span: Callable, wi: np.ndarray, wo: np.ndarray, p: np.ndarray, c: 
     flat = (lambda x: x.T.reshape(-1)) if soa else (lambda x: x.reshape(-1))
     cs, ps = (n, 1) if soa else (1, 3)
     lock = contextlib.nullcontext() if serial else _RUN_LOCK
-    with lock, (_compile_options(_span_width(), SPAN_UNROLL_THRESHOLD) if first else contextlib.nullcontext()), \
+    with lock, (_compile_options(_on_avx512(SPAN_VECTOR_WIDTH), SPAN_UNROLL_THRESHOLD) if first else contextlib.nullcontext()), \
             vecmath.compiling():
         t0 = time.perf_counter()
         drive(flat(wi), flat(wo), pt, c, flat(out), lim, lo2, hi2, bad, cs, ps, n)
@@ -687,7 +683,7 @@ def run(kernel: Callable, wi: np.ndarray, wo: np.ndarray, p: np.ndarray, c: np.n
     ck = _compile_key(drive, pt, wi, wo)
     first = ck not in _COMPILED  # this call may compile (or load) a specialisation of the driver
     lock = contextlib.nullcontext() if serial else _RUN_LOCK  # a serial call launches no thread pool
-    with lock, (_compile_options(F32_VECTOR_WIDTH if f32 else 0, interleave=_special_interleave()) if first else contextlib.nullcontext()), \
+    with lock, (_compile_options(F32_VECTOR_WIDTH if f32 else 0, interleave=_on_avx512(SPECIAL_INTERLEAVE)) if first else contextlib.nullcontext()), \
             vecmath.compiling():
         t0 = time.perf_counter()
         if soa:  # the transposes of Fortran-ordered (n, 3) arrays are C-contiguous: flat views, no copy
