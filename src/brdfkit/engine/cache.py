@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import contextlib
 import hashlib
+import math
 import os
 from pathlib import Path
 from typing import Callable, Iterator
@@ -159,37 +160,50 @@ def jit(fn: Callable | None = None, *, inline: bool = False, reassociate: bool =
 class vectorize:
     """An array function over a scalar term: broadcasting, float64 computation, any output dtype.
 
-    ``vectorize(d_ggx)(hx, hy, hz, ax, ay)`` applies the scalar source element-wise
-    (a numba ufunc built lazily and cached on disk; under the reference engine the
-    uncompiled Python function via ``np.frompyfunc``). The result is float64;
-    pass ``dtype=np.float32`` to round it once to float32.
+    ``vectorize(d_ggx)(hx, hy, hz, ax, ay)`` applies the scalar source element-wise: compiled, a
+    loop generated for it and cached on disk (:func:`brdfkit.engine.driver.elementwise_driver_for`,
+    loaded at the first call); under the reference engine the uncompiled Python function via
+    ``np.frompyfunc``. The result is float64; pass ``dtype=np.float32`` to round it once to float32.
     """
 
     def __init__(self, scalar: Callable, nargs: int) -> None:
         self.scalar = scalar
         self.nargs = nargs
-        self._ufunc = None
+        self._drive = None
         self.__doc__ = getattr(scalar, "__doc__", None)
         self.__name__ = getattr(scalar, "__name__", "vectorized")
 
-    def _compiled(self):
-        if self._ufunc is None:
-            py = getattr(self.scalar, "py_func", self.scalar)
-            sig = "float64(" + ",".join(["float64"] * self.nargs) + ")"
-            with in_cache_dir():
-                self._ufunc = numba.vectorize([sig], cache=True)(py)
-        return self._ufunc
+    def _compiled(self, arrs: list[np.ndarray]) -> np.ndarray:
+        if self._drive is None:
+            from .driver import elementwise_driver_for
+
+            self._drive = elementwise_driver_for(self.scalar, self.nargs)
+        shape = np.broadcast_shapes(*(a.shape for a in arrs))
+        n = math.prod(shape)
+        flat = []
+        for a in arrs:  # 1-D views: the array itself, a repeated value (stride 0), or a broadcast copy
+            if a.shape == shape:
+                flat.append(a.reshape(-1))
+            elif a.size == 1:
+                flat.append(np.broadcast_to(a.reshape(-1), (n,)))
+            else:
+                flat.append(np.broadcast_to(a, shape).reshape(-1))
+        out = np.empty(n)
+        self._drive(*flat, out)
+        return out.reshape(shape)
 
     def __call__(self, *args, dtype=np.float64) -> np.ndarray:
         from . import engine
         from .reference import pure
 
+        if len(args) != self.nargs:
+            raise TypeError(f"{self.__name__} takes {self.nargs} arguments, got {len(args)}")
         arrs = [np.asarray(a, dtype=np.float64) for a in args]
         if engine() == "reference":
             f = np.frompyfunc(pure(self.scalar), self.nargs, 1)
             out = np.asarray(f(*arrs), dtype=np.float64)
         else:
-            out = self._compiled()(*arrs)
+            out = self._compiled(arrs)
         with np.errstate(over="ignore"):
             return np.asarray(out).astype(dtype, copy=False)
 
