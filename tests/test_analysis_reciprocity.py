@@ -108,3 +108,44 @@ def test_lighting_equation_forms_are_not_reciprocal(name, s):
     ci, co = np.cos(np.radians(w["wi_deg"][0])), np.cos(np.radians(w["wo_deg"][0]))
     # the ratio is exactly cos θo / cos θi (floors at 1e-4 aside)
     assert fa / fb == pytest.approx(max(co, 1e-4) / max(ci, 1e-4), rel=1e-3)  # angles rounded to 1e-4°
+
+
+def _numpy_worst(fab, fba):
+    """The numpy form the compiled reduction replaced (kept here as its oracle)."""
+    big = np.maximum(np.abs(fab), np.abs(fba))
+    floor = 1e-12 * float(big.max()) if big.size else 0.0
+    with np.errstate(divide="ignore", invalid="ignore"):
+        rel = np.where(big > max(floor, 1e-300), np.abs(fab - fba) / np.where(big > 0, big, 1.0), 0.0)
+    flat = int(np.argmax(rel))
+    return float(rel.flat[flat]), flat
+
+
+@pytest.mark.parametrize("case", ["random", "ties", "zeros", "tiny", "negative", "single"])
+def test_worst_asymmetry_is_the_numpy_formula_bit_for_bit(case):
+    """The compiled reduction of reciprocity_report gives numpy's value and first-maximum index: ties go
+    to the first, pairs below 1e-12 of the largest value (or 1e-300) are skipped, all-zero gives (0, 0)."""
+    from brdfkit.analysis.reciprocity import worst_asymmetry
+
+    rng = np.random.default_rng(7)
+    a = rng.uniform(0.0, 2.0, (500, 3))
+    b = a * rng.uniform(0.9, 1.1, a.shape)
+    if case == "ties":
+        b = a.copy()
+        b[[10, 20, 30], [0, 1, 2]] *= 2.0  # three equal maxima: the first counts
+    elif case == "zeros":
+        a[:] = 0.0
+        b[:] = 0.0
+    elif case == "tiny":
+        a[5:] *= 1e-13  # all but five pairs below the floor: their asymmetry (up to 10 %) does not count
+        b[5:] = a[5:] * 1.5
+    elif case == "negative":
+        a[3, 1] = -0.5
+    elif case == "single":
+        a, b = a[:1], b[:1]
+    got = worst_asymmetry(np.ascontiguousarray(a), np.ascontiguousarray(b))
+    want = _numpy_worst(a, b)
+    assert (float(got[0]), int(got[1])) == want
+    if case == "ties":
+        assert want == (0.5, 10 * 3 + 0)
+    if case == "zeros":
+        assert want == (0.0, 0)
