@@ -179,6 +179,15 @@ def test_models_without_a_kernel_use_their_numpy_eval(eng, restore_engine):
         m.eval(wi, wo * 3)
 
 
+def _hits_and_misses_in_two_processes(code: str, cache: "os.PathLike") -> tuple[list[str], list[str]]:
+    """What ``code`` prints (numba's cache hits and misses) in a first and then a second fresh process that
+    share the brdfkit cache folder ``cache``."""
+    env = dict(os.environ, BRDFKIT_CACHE_DIR=str(cache))
+    runs = [subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True)
+            for _ in range(2)]
+    return runs[0].stdout.split(), runs[1].stdout.split()
+
+
 def test_kernels_are_cached_on_disk(tmp_path):
     """A fresh process with a warm cache compiles nothing (numba reports cache hits, no misses)."""
     code = (
@@ -191,11 +200,7 @@ def test_kernels_are_cached_on_disk(tmp_path):
         "s = driver.driver_for(microfacet_kernel).stats\n"
         "print(sum(s.cache_hits.values()), sum(s.cache_misses.values()))\n"
     )
-    env = dict(os.environ, BRDFKIT_CACHE_DIR=str(tmp_path))
-    first = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True)
-    assert first.stdout.split() == ["0", "2"]  # compiled: float64 and float32
-    second = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True)
-    assert second.stdout.split() == ["2", "0"]
+    assert _hits_and_misses_in_two_processes(code, tmp_path) == (["0", "2"], ["2", "0"])  # float64 and float32
     from brdfkit.engine import vecmath
 
     stem = "drv_brdfkit_models_microfacet_microfacet_kernel" + ("__vm" if vecmath.available() else "")
@@ -309,11 +314,7 @@ def test_term_array_wrappers_load_from_the_disk_cache_in_a_new_process(tmp_path)
         "d = driver.elementwise_driver_for(F.f_conductor, 3)\n"
         "print(sum(d.stats.cache_hits.values()), sum(d.stats.cache_misses.values()))\n"
     )
-    env = dict(os.environ, BRDFKIT_CACHE_DIR=str(tmp_path))
-    first = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True)
-    assert first.stdout.split() == ["0", "1"]
-    second = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True)
-    assert second.stdout.split() == ["1", "0"]
+    assert _hits_and_misses_in_two_processes(code, tmp_path) == (["0", "1"], ["1", "0"])
     assert any(tmp_path.glob("numba-*/drivers/vec_brdfkit_terms_fresnel_f_conductor.py"))
 
 
