@@ -37,6 +37,9 @@ pairs. Its calls run :data:`SPAN_TEMPLATE` (:func:`run` with ``span``): the unit
 span, chunk by chunk, in parallel or serially as above, on rows or Fortran-ordered arrays alike (the
 span takes the component and pair strides); calls of at most :data:`SPAN_MIN_PAIRS` pairs run the per-pair
 kernel, which starts faster. The reference engine runs the per-pair kernel.
+
+The array functions of ``terms`` (:class:`brdfkit.engine.cache.vectorize`) run an *elementwise* driver
+generated the same way (:data:`ELEMENTWISE_TEMPLATE`): the scalar term over 1-D arrays of any stride.
 """
 
 from __future__ import annotations
@@ -513,7 +516,7 @@ def elementwise_driver_for(scalar: Callable, nargs: int) -> Callable:
     stride of 0 for a broadcast value; ``out`` contiguous), for :class:`brdfkit.engine.cache.vectorize`.
 
     A generated module like the drivers, compiled for that one signature (layout ``A``) and cached on disk, so a
-    new process only loads it (~5 ms). A numba ufunc (``numba.vectorize``, what this replaces) caches its kernel
+    new process only loads it (3–4 ms). A numba ufunc (``numba.vectorize``, what this replaces) caches its kernel
     but builds and compiles its wrapper anew in every process: 65–86 ms per function, measured at the first
     call in a fresh process, four of them in each ``check --all`` worker. Compiled without the vector math
     library: the values are libm's, as the ufunc's were."""
