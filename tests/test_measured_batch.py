@@ -159,11 +159,7 @@ def test_dask_cluster_with_a_worker_killed_mid_batch_equals_local(cluster, refer
 
 def test_resume_after_a_crash_completes_the_identical_table(reference, tmp_path):
     out = tmp_path / "crash"
-    # fits of 3000 samples (each ~0.1-0.2 s, not ~20 ms as at CLI_ARGS' 600): after the second, the other
-    # ten take more than a second, so a test process descheduled for a moment on a loaded machine (the
-    # full suite on two cores) still interrupts a running batch, not one that has just finished
-    slow = ["--set", "nielsen", "--limit", "4", "--samples", "3000", "--starts", "4"]
-    args = _cli("-m", "lambert", "-m", "blinn-phong", "-m", "ward", *slow, "--out", str(out), "--workers", "1")
+    args = _cli("-m", "lambert", "-m", "blinn-phong", "-m", "ward", *CLI_ARGS, "--out", str(out), "--workers", "1")
     p = subprocess.Popen(args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, env=_env(), start_new_session=True)
     try:
         t0 = time.time()
