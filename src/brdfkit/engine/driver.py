@@ -518,7 +518,7 @@ def elementwise_driver_for(scalar: Callable, nargs: int) -> Callable:
     A generated module like the drivers, compiled for that one signature (layout ``A``) and cached on disk, so a
     new process only loads it (3–4 ms). A numba ufunc (``numba.vectorize``, what this replaces) caches its kernel
     but builds and compiles its wrapper anew in every process: 65–86 ms per function, measured at the first
-    call in a fresh process, four of them in each ``check --all`` worker. Compiled without the vector math
+    call in a fresh process, three in each ``check --all`` worker that checks HTSG. Compiled without the vector math
     library: the values are libm's, as the ufunc's were."""
     py = getattr(scalar, "py_func", scalar)
     key = ("elementwise", py.__module__, py.__name__, nargs)
