@@ -179,16 +179,9 @@ class vectorize:
 
             self._drive = elementwise_driver_for(self.scalar, self.nargs)
         shape = np.broadcast_shapes(*(a.shape for a in arrs))
-        n = math.prod(shape)
-        flat = []
-        for a in arrs:  # 1-D views: the array itself, a repeated value (stride 0), or a broadcast copy
-            if a.shape == shape:
-                flat.append(a.reshape(-1))
-            elif a.size == 1:
-                flat.append(np.broadcast_to(a.reshape(-1), (n,)))
-            else:
-                flat.append(np.broadcast_to(a, shape).reshape(-1))
-        out = np.empty(n)
+        # 1-D views where numpy can give one (a contiguous array as is, a single value as stride 0), else copies
+        flat = [np.broadcast_to(a, shape).reshape(-1) for a in arrs]
+        out = np.empty(math.prod(shape))
         self._drive(*flat, out)
         return out.reshape(shape)
 

@@ -411,10 +411,14 @@ def _load(key: tuple, stem: str, src: str) -> Callable:
         return mod.drive
 
 
+def _ident(py) -> str:
+    """A Python function's module and name as one identifier, for a generated module's file name."""
+    return re.sub(r"[^A-Za-z0-9_]", "_", f"{py.__module__}_{py.__name__}")
+
+
 def _stem(py, f32: bool = False) -> str:
     # drivers that call libmvec (.vecmath) have their own files: a process without it never loads one
-    return ("drv_" + re.sub(r"[^A-Za-z0-9_]", "_", f"{py.__module__}_{py.__name__}") + ("__f32" if f32 else "")
-            + ("__vm" if vecmath.available() else ""))
+    return "drv_" + _ident(py) + ("__f32" if f32 else "") + ("__vm" if vecmath.available() else "")
 
 
 #: how a generated driver gets its kernel: the source itself (float64), or its float32 twin
@@ -529,8 +533,7 @@ def elementwise_driver_for(scalar: Callable, nargs: int) -> Callable:
     src = ELEMENTWISE_TEMPLATE.format(module=py.__module__, name=py.__name__, nargs=nargs,
                                       arrays=", ".join(["IN"] * nargs), args=", ".join(names),
                                       items=", ".join(f"{n}[i]" for n in names))
-    stem = "vec_" + re.sub(r"[^A-Za-z0-9_]", "_", f"{py.__module__}_{py.__name__}")
-    return _load(key, stem, src)
+    return _load(key, "vec_" + _ident(py), src)
 
 
 #: LLVM's vector width for the span drivers where the CPU has AVX-512: 8 float64 lanes. Its cost model
