@@ -1,0 +1,116 @@
+"""Wall time of one-shot `brdfkit` commands beside the floor of the tools they run on.
+
+    .venv/bin/python benchmarks/bench_cli.py [--rounds 7]
+
+Issue 9 asks for `brdfkit eval` < 1 s and one `brdfkit fit merl/gold-metallic-paint --model
+microfacet` < 1 s wall. A fresh process pays the interpreter, numpy, numba (its import and, at the
+first call of a compiled function, its target's initialisation, even for a function loaded from its
+disk cache) and, for a fit, ``scipy.optimize`` before any of brdfkit's work. This script times, each
+in its own fresh process, the rounds alternating:
+
+* ``python -c pass``, ``import numpy``;
+* ``numba floor``: ``import numba`` and one call of a trivial ``@njit(cache=True)`` function loaded from
+  its disk cache (the least a process that runs one compiled kernel pays), with numba's BLAS probe
+  held back as the ``brdfkit`` command holds it back (``engine.skip_blas_probe``), and as numba does
+  by default (the probe imports all of ``scipy.linalg``);
+* ``numba + scipy.optimize floor``: the same and ``import scipy.optimize`` (the least a fit pays);
+* the commands: ``brdfkit eval``, ``brdfkit fit`` (both with brdfkit's numba cache warm: each
+  command runs once before the rounds).
+
+It prints the medians and each command's time above its floor (what brdfkit's own imports and work
+cost). Tests never assert on time; on a shared machine read the medians of the same run side by side.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+NUMBA_FLOOR = """
+import numba
+{probe}
+@numba.njit(cache=True)
+def one(x):
+    return x + 1.0
+
+one(1.0)
+"""
+
+#: what ``brdfkit.engine.skip_blas_probe`` does for the console script (numba's BLAS probe would import
+#: all of scipy.linalg at the first compiled call), without importing brdfkit
+SKIP_PROBE = """
+import sys
+sys.modules["scipy.linalg"] = None
+import numba.np.arraymath
+del sys.modules["scipy.linalg"]
+"""
+
+
+def _brdfkit() -> list[str]:
+    exe = Path(sys.executable).with_name("brdfkit")
+    return [str(exe)] if exe.exists() else [sys.executable, "-m", "brdfkit"]
+
+
+def _wall(cmd: list[str], env: dict[str, str]) -> float:
+    t = time.perf_counter()
+    p = subprocess.run(cmd, capture_output=True, text=True, env=env)
+    dt = time.perf_counter() - t
+    if p.returncode != 0:
+        raise SystemExit(f"{' '.join(cmd)}: exit {p.returncode}: {p.stderr.strip()[-200:]}")
+    return dt
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--rounds", type=int, default=7, help="fresh processes per row (default 7)")
+    args = ap.parse_args()
+    if args.rounds < 1:
+        raise SystemExit("--rounds must be at least 1")
+    with tempfile.TemporaryDirectory(prefix="bench_cli_") as tmp:
+        floor = Path(tmp) / "numba_floor.py"
+        floor.write_text(NUMBA_FLOOR.format(probe=SKIP_PROBE))
+        floor_probe = Path(tmp) / "numba_probe_floor.py"
+        floor_probe.write_text(NUMBA_FLOOR.format(probe=""))
+        floor_scipy = Path(tmp) / "numba_scipy_floor.py"
+        floor_scipy.write_text(NUMBA_FLOOR.format(probe="") + "import scipy.optimize\n")
+        env = dict(os.environ)
+        env_floor = dict(env, NUMBA_CACHE_DIR=str(Path(tmp) / "numba-cache"))
+        py = sys.executable
+        bk = _brdfkit()
+        rows = [
+            ("python -c pass", [py, "-c", "pass"], env, None),
+            ("import numpy", [py, "-c", "import numpy"], env, None),
+            ("numba floor (BLAS probe skipped, as brdfkit's command does)", [py, str(floor)], env_floor, None),
+            ("numba floor (numba's default: its BLAS probe)", [py, str(floor_probe)], env_floor, None),
+            ("numba + scipy.optimize floor", [py, str(floor_scipy)], env_floor, None),
+            ("brdfkit eval microfacet --wi 30,0 --wo 30,180", bk + ["eval", "microfacet", "--wi", "30,0", "--wo", "30,180"],
+             env, "numba floor (BLAS probe skipped, as brdfkit's command does)"),
+            ("brdfkit fit merl/gold-metallic-paint --model microfacet",
+             bk + ["fit", "merl/gold-metallic-paint", "--model", "microfacet"], env, "numba + scipy.optimize floor"),
+        ]
+        for _, cmd, e, _ in rows:  # warm-up: numba caches (the floor's and brdfkit's), the OS's file cache
+            _wall(cmd, e)
+        times: dict[str, list[float]] = {name: [] for name, *_ in rows}
+        load0 = os.getloadavg()[0]
+        for _ in range(args.rounds):
+            for name, cmd, e, _ in rows:
+                times[name].append(_wall(cmd, e))
+        load1 = os.getloadavg()[0]
+    print(f"{args.rounds} rounds, fresh processes, alternating; load average {load0:.2f} before, {load1:.2f} after; "
+          f"{os.cpu_count()} CPUs visible")
+    print(f"{'command':<66} {'median s':>9} {'min s':>7} {'max s':>7} {'above its floor':>16}")
+    med = {name: statistics.median(t) for name, t in times.items()}
+    for name, _, _, base in rows:
+        t = times[name]
+        above = f"{med[name] - med[base]:+.2f} s" if base else ""
+        print(f"{name:<66} {med[name]:9.2f} {min(t):7.2f} {max(t):7.2f} {above:>16}")
+
+
+if __name__ == "__main__":
+    main()
