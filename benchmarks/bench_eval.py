@@ -22,7 +22,7 @@ the upper hemisphere):
 
 The float64 CPU rate (evaluations per CPU second of the process, all threads) counts, on
 numba's TBB threading layer, the moment its workers spin after a call before they sleep: it
-reads lower than on workqueue for the same kernel (README, "Speed", "Threads").
+reads lower than on workqueue for the same kernel (docs/speed.md, "Threads").
 
 The machine's load average is printed with the table: on the shared 2-core
 development machine figures vary by ±30 % from run to run, and those taken on a

@@ -25,7 +25,7 @@ statistics only when that count is not zero). Its chunks run in parallel, or ser
 the calling thread (``drive_serial``, the same loop) when numba has one thread or the call's
 work, estimated from the driver's earlier calls, is below :data:`PARALLEL_MIN_S`: a parallel
 launch costs more than a fitter's evaluation of 3000 samples. LLVM vectorises that loop where the
-kernel calls no libm function (issue 9; README, "Speed"). Kernels whose ``p`` holds a
+kernel calls no libm function (issue 9; docs/speed.md). Kernels whose ``p`` holds a
 table (longer than :data:`MAX_TUPLE`) keep the generic driver. Fortran-ordered ``(n, 3)`` arrays
 (each component contiguous) run :data:`SOA_TEMPLATE`, the specialised loop with unit-stride
 component access, derived from :data:`SPECIAL_TEMPLATE` by a checked list of edits.
@@ -286,7 +286,7 @@ _RUN_LOCK = (contextlib.nullcontext() if _engine.THREADING_LAYER in ("tbb", "saf
 
 #: LLVM's loop-vectoriser width for the float32 specialised drivers: 16 lanes (one AVX-512 register).
 #: Its cost model picks 8 for them on this CPU (interleaved (n, 3) loads), which measured half the
-#: speed of 16 (README, "Speed"); float64 keeps the cost model's choice (16 measured slower there).
+#: speed of 16 (docs/speed.md); float64 keeps the cost model's choice (16 measured slower there).
 F32_VECTOR_WIDTH = 16
 #: LLVM's loop-vectoriser interleave count for the specialised drivers on a CPU with AVX-512: 2 vector
 #: iterations in flight per loop trip (0: the cost model's choice, which is 1 for these loop bodies). A
