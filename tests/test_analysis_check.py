@@ -287,6 +287,118 @@ def test_every_chart_folds_at_every_angle_and_the_half_rule_integrates_the_same(
                 assert _fold(wi, bad) is None
 
 
+def _albedo_module():
+    import importlib
+
+    return importlib.import_module("brdfkit.analysis.albedo")  # the package's name albedo is the function
+
+
+def _plan_key(fold=True):
+    """check's plan at φo = 0: its angles, level fast, every chart (albedo_result's defaults)."""
+    from brdfkit.analysis.verdict import DEFAULT_THETA_DEG
+
+    return (tuple(float(x) for x in np.radians(DEFAULT_THETA_DEG)), 0.0, "fast", ("H", "R", "D"), 100_000, fold)
+
+
+def _assert_same_plan(built, other):
+    assert built[0].dtype == other[0].dtype and np.array_equal(built[0], other[0]) and not other[0].flags.writeable
+    assert len(built[1]) == len(other[1]) > 0
+    for b, o in zip(built[1], other[1]):
+        for u, v in zip(b[:4], o[:4]):  # wi, wo, wc, starts
+            assert u.dtype == v.dtype and u.shape == v.shape and np.array_equal(u, v) and not v.flags.writeable
+        assert b[4] == o[4]  # each rule's (chart, resolution, angle index)
+
+
+def test_a_plan_from_the_disk_cache_is_the_built_plan_bit_for_bit(tmp_path, monkeypatch):
+    A = _albedo_module()
+    path = tmp_path / "plans" / "plan.npz"
+    monkeypatch.setattr(A, "_plan_file", lambda key: path)
+    key = _plan_key()
+    built = A._make_plan(*key)
+    A._build_plan.cache_clear()
+    try:
+        _assert_same_plan(built, A._build_plan(*key))  # built, then stored
+        assert path.is_file()
+        _assert_same_plan(built, A._load_plan(path, key))
+        A._build_plan.cache_clear()
+        _assert_same_plan(built, A._build_plan(*key))  # read back
+        # the albedo from a stored plan: the same sums as from the rules themselves
+        m = bk.model("microfacet", alpha=0.3)
+        theta = np.array(key[0])
+        from_disk = A.albedo_result(m, theta, level="fast", mirror_symmetric=True)
+        A._build_plan.cache_clear()
+        monkeypatch.setattr(A, "_plan_file", lambda key: tmp_path / "other" / "plan.npz")
+        from_rules = A.albedo_result(m, theta, level="fast", mirror_symmetric=True)
+        assert np.array_equal(from_disk.value, from_rules.value) and np.array_equal(from_disk.error, from_rules.error)
+    finally:
+        A._build_plan.cache_clear()
+
+
+@pytest.mark.parametrize("damage", ["empty", "truncated", "garbage", "rules-past-the-nodes", "float32-nodes",
+                                    "a-rule-missing", "other-angles"])
+def test_a_damaged_plan_file_is_not_used_and_is_written_again(tmp_path, monkeypatch, damage):
+    A = _albedo_module()
+    path = tmp_path / "plan.npz"
+    monkeypatch.setattr(A, "_plan_file", lambda key: path)
+    key = _plan_key()
+    A._build_plan.cache_clear()
+    try:
+        A._build_plan(*key)
+        good = path.read_bytes()
+        if damage == "empty":
+            path.write_bytes(b"")
+        elif damage == "truncated":
+            path.write_bytes(good[: len(good) // 2])
+        elif damage == "garbage":
+            path.write_bytes(b"not a plan " * 1000)
+        else:
+            with np.load(path) as z:
+                arrays = {k: z[k] for k in z.files}
+            if damage == "rules-past-the-nodes":
+                arrays["rules0"][-1, 0] = arrays["wc0"].shape[0]
+            elif damage == "float32-nodes":
+                arrays["wi0"] = arrays["wi0"].astype(np.float32)
+            elif damage == "a-rule-missing":  # its nodes taken as the previous rule's
+                arrays["rules0"] = arrays["rules0"][:-1]
+            else:
+                arrays["wos"] = arrays["wos"][::-1].copy()
+            with open(path, "wb") as f:
+                np.savez(f, **arrays)
+        assert A._load_plan(path, key) is None
+        A._build_plan.cache_clear()
+        built = A._make_plan(*key)
+        _assert_same_plan(built, A._build_plan(*key))  # rebuilt, not read
+        _assert_same_plan(built, A._load_plan(path, key))  # and stored whole again
+    finally:
+        A._build_plan.cache_clear()
+
+
+def test_plans_are_stored_at_phi_zero_only_and_an_unwritable_folder_is_no_error(tmp_path, monkeypatch):
+    A = _albedo_module()
+    theta, _, level, charts, max_nodes, _ = _plan_key()
+
+    def no_file(key):
+        raise AssertionError(f"a plan at φo = {key[1]} looked for its disk cache")
+
+    monkeypatch.setattr(A, "_plan_file", no_file)
+    A._build_plan.cache_clear()
+    try:
+        A._build_plan(theta, 0.5, level, charts, max_nodes, False)
+        blocker = tmp_path / "a-file"
+        blocker.write_text("")
+        monkeypatch.setattr(A, "_plan_file", lambda key: blocker / "plans" / "plan.npz")  # its folder cannot exist
+        _assert_same_plan(A._make_plan(*_plan_key()), A._build_plan(*_plan_key()))
+        assert blocker.read_text() == ""
+    finally:
+        A._build_plan.cache_clear()
+    # the real file: in the compiled kernels' folder, one per plan
+    from brdfkit.engine.cache import cache_dir
+
+    monkeypatch.undo()
+    a, b = A._plan_file(_plan_key(True)), A._plan_file(_plan_key(False))
+    assert a != b and a.parent == b.parent == cache_dir() / "albedo-plans" and a.suffix == ".npz"
+
+
 def test_check_all_tasks_cover_every_setting_once_and_keep_models_together():
     from brdfkit.analysis import verdict
 

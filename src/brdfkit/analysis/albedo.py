@@ -53,6 +53,7 @@ from __future__ import annotations
 import functools
 import math
 import threading
+import zipfile
 from dataclasses import dataclass
 from typing import Any
 
@@ -327,8 +328,97 @@ def _plan(*key):
         return _build_plan(*key)
 
 
+#: a plan at φo = 0 (the one every check integrates over, at every angle of every model) is kept on disk
+#: if it holds at most this many nodes (:func:`_build_plan`): 32 bytes a node (``wi`` and ``wc``), 12 MB for
+#: ``check``'s angles at level ``fast``
+PLAN_CACHE_MAX_NODES = 2_000_000
+
+
+def _plan_file(key: tuple):
+    """The disk-cache file of the plan ``key`` (``_build_plan``'s arguments): in the compiled kernels' folder,
+    which is named by a hash of the package source (:func:`brdfkit.engine.cache.cache_dir`), so a change to
+    the rules' code means a new file; the level's resolutions and numpy's version (its Gauss-Legendre nodes)
+    are part of the name."""
+    import hashlib
+
+    from ..engine.cache import cache_dir
+
+    digest = hashlib.sha1(repr((key, LEVELS[key[2]], np.__version__)).encode()).hexdigest()[:20]
+    return cache_dir() / "albedo-plans" / f"plan-{digest}.npz"
+
+
+def _load_plan(path, key: tuple):
+    """The plan ``key`` (``_build_plan``'s arguments) stored at ``path`` by :func:`_store_plan`, or None if the
+    file is missing or not whole: every array of the right type and shape, the rules' rows in order within
+    the nodes, each (chart, resolution, angle) of the key exactly once, the viewing directions the key's."""
+    theta, phi_o, _level, charts, _max_nodes, _fold = key
+    expected = sorted((c, r, k) for c in range(len(charts)) for r in (0, 1) for k in range(len(theta)))
+    try:
+        with np.load(path, allow_pickle=False) as z:
+            wos = z["wos"]
+            if not np.array_equal(wos, spherical_to_vector(np.asarray(theta, dtype=np.float64), phi_o)):
+                return None
+            batches, seen = [], []
+            for b in range(int(z["batches"])):
+                wi, wc, rows = z[f"wi{b}"], z[f"wc{b}"], z[f"rules{b}"]  # rows: start, chart, resolution, angle
+                n = wc.shape[0]
+                if (wi.dtype != np.float64 or wc.dtype != np.float64 or wc.ndim != 1 or wi.shape != (n, 3)
+                        or rows.dtype != np.int64 or rows.ndim != 2 or rows.shape[1] != 4 or len(rows) == 0):
+                    return None
+                starts, ch, ri, k = rows[:, 0], rows[:, 1], rows[:, 2], rows[:, 3]
+                seen += [(int(c), int(r), int(a)) for c, r, a in zip(ch, ri, k)]
+                if starts[0] != 0 or np.any(np.diff(starts) < 0) or starts[-1] >= n:
+                    return None
+                wo = np.repeat(wos[k], np.diff(np.append(starts, n)), axis=0)  # each rule's viewing direction
+                keys = tuple((charts[c], int(r), int(a)) for c, r, a in zip(ch, ri, k))
+                batches.append((*_frozen(wi, wo, wc, starts.astype(np.intp)), keys))
+    except (OSError, ValueError, KeyError, IndexError, EOFError, zipfile.BadZipFile):  # missing, truncated, foreign
+        return None
+    if sorted(seen) != expected:  # a rule missing, twice, or not the key's (an index out of range is caught above)
+        return None
+    (wos,) = _frozen(wos)
+    return wos, tuple(batches)
+
+
+def _store_plan(path, plan, charts: tuple) -> None:
+    """Write ``plan`` to ``path`` atomically (the viewing directions of each row are not stored: they
+    follow from its rule). A folder that cannot be written leaves the plan in memory only."""
+    import contextlib
+
+    from ..fileio import atomic_path
+
+    wos, batches = plan
+    arrays = {"wos": wos, "batches": np.array(len(batches))}
+    for b, (wi, _wo, wc, starts, keys) in enumerate(batches):
+        arrays[f"wi{b}"] = wi
+        arrays[f"wc{b}"] = wc
+        arrays[f"rules{b}"] = np.array([(s, charts.index(c), r, k) for s, (c, r, k) in zip(starts, keys)],
+                                       dtype=np.int64).reshape(-1, 4)
+    with contextlib.suppress(OSError):
+        path.parent.mkdir(parents=True, exist_ok=True)
+        with atomic_path(path) as tmp, open(tmp, "wb") as f:
+            np.savez(f, **arrays)
+
+
 @functools.lru_cache(maxsize=6)
 def _build_plan(theta: tuple, phi_o: float, level: str, charts: tuple, max_nodes: int, fold: bool = False):
+    """:func:`_make_plan`, from the disk cache where it is kept (φo = 0, at most
+    :data:`PLAN_CACHE_MAX_NODES` nodes): a new process then reads the plan that every ``check`` of
+    every model integrates over instead of building its rules (0.2 s at ``check``'s angles, level
+    ``fast``). The stored plan is the built one, bit for bit."""
+    key = (theta, phi_o, level, charts, max_nodes, fold)
+    path = _plan_file(key) if phi_o == 0.0 else None
+    if path is not None:
+        plan = _load_plan(path, key)
+        if plan is not None:
+            return plan
+    plan = _make_plan(*key)
+    if path is not None and sum(b[2].shape[0] for b in plan[1]) <= PLAN_CACHE_MAX_NODES:
+        _store_plan(path, plan, charts)
+    return plan
+
+
+def _make_plan(theta: tuple, phi_o: float, level: str, charts: tuple, max_nodes: int, fold: bool = False):
     """The evaluation plan of :func:`albedo_result`, built once per angle set, level and charts.
 
     Returns the viewing directions ``wos`` (n, 3) and batches of at most about ``max_nodes``
@@ -338,7 +428,7 @@ def _build_plan(theta: tuple, phi_o: float, level: str, charts: tuple, max_nodes
     for φo = 0): each rule symmetric about the plane of wo is replaced by its half
     (:func:`_fold`), half the evaluations for integrands with that symmetry. ``check --all``
     integrates every model over the same angles, so caching this spares each call the
-    concatenation (the arrays are read-only; ~40 MB per entry at level ``fast``).
+    concatenation (the arrays are read-only; ~40 MB per entry at level ``fast``, ~20 MB folded).
     """
     (n1r, n1a), (n2r, n2a) = LEVELS[level]
     flat = np.asarray(theta, dtype=np.float64)
