@@ -12,7 +12,9 @@ Folder: ``$BRDFKIT_CACHE_DIR`` if set, else ``$XDG_CACHE_HOME/brdfkit`` (default
 ``~/.cache/brdfkit``), then ``numba-<hash>/``. If it cannot be created, numba
 falls back to its usual ``__pycache__`` locations. When a process creates the folder
 of a new source version, folders of older versions unused for an hour are deleted
-(the most recent one is kept; :func:`prune`).
+(the most recent one is kept; :func:`prune`). The folder also holds ``albedo-plans/``: the
+quadrature plan every ``check`` integrates over (:mod:`brdfkit.analysis.albedo`, ``_build_plan``),
+keyed by the same source hash.
 """
 
 from __future__ import annotations
