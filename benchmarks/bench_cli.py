@@ -83,16 +83,18 @@ def main() -> None:
         env_floor = dict(env, NUMBA_CACHE_DIR=str(Path(tmp) / "numba-cache"))
         py = sys.executable
         bk = _brdfkit()
+        floor_name = "numba floor (BLAS probe skipped, as brdfkit's command does)"
+        fit_floor_name = "numba + scipy.optimize floor"
         rows = [
             ("python -c pass", [py, "-c", "pass"], env, None),
             ("import numpy", [py, "-c", "import numpy"], env, None),
-            ("numba floor (BLAS probe skipped, as brdfkit's command does)", [py, str(floor)], env_floor, None),
+            (floor_name, [py, str(floor)], env_floor, None),
             ("numba floor (numba's default: its BLAS probe)", [py, str(floor_probe)], env_floor, None),
-            ("numba + scipy.optimize floor", [py, str(floor_scipy)], env_floor, None),
+            (fit_floor_name, [py, str(floor_scipy)], env_floor, None),
             ("brdfkit eval microfacet --wi 30,0 --wo 30,180", bk + ["eval", "microfacet", "--wi", "30,0", "--wo", "30,180"],
-             env, "numba floor (BLAS probe skipped, as brdfkit's command does)"),
+             env, floor_name),
             ("brdfkit fit merl/gold-metallic-paint --model microfacet",
-             bk + ["fit", "merl/gold-metallic-paint", "--model", "microfacet"], env, "numba + scipy.optimize floor"),
+             bk + ["fit", "merl/gold-metallic-paint", "--model", "microfacet"], env, fit_floor_name),
         ]
         for _, cmd, e, _ in rows:  # warm-up: numba caches (the floor's and brdfkit's), the OS's file cache
             _wall(cmd, e)
