@@ -50,7 +50,9 @@ error estimate, and the chart with the smaller estimate gives the answer
 
 from __future__ import annotations
 
+import contextlib
 import functools
+import hashlib
 import math
 import threading
 import zipfile
@@ -339,8 +341,6 @@ def _plan_file(key: tuple):
     which is named by a hash of the package source (:func:`brdfkit.engine.cache.cache_dir`), so a change to
     the rules' code means a new file; the level's resolutions and numpy's version (its Gauss-Legendre nodes)
     are part of the name."""
-    import hashlib
-
     from ..engine.cache import cache_dir
 
     digest = hashlib.sha1(repr((key, LEVELS[key[2]], np.__version__)).encode()).hexdigest()[:20]
@@ -383,9 +383,7 @@ def _load_plan(path, key: tuple):
 def _store_plan(path, plan, charts: tuple) -> None:
     """Write ``plan`` to ``path`` atomically (the viewing directions of each row are not stored: they
     follow from its rule). A folder that cannot be written leaves the plan in memory only."""
-    import contextlib
-
-    from ..fileio import atomic_path
+    from ..fileio import atomic_open
 
     wos, batches = plan
     arrays = {"wos": wos, "batches": np.array(len(batches))}
@@ -396,7 +394,7 @@ def _store_plan(path, plan, charts: tuple) -> None:
                                        dtype=np.int64).reshape(-1, 4)
     with contextlib.suppress(OSError):
         path.parent.mkdir(parents=True, exist_ok=True)
-        with atomic_path(path) as tmp, open(tmp, "wb") as f:
+        with atomic_open(path, "wb") as f:
             np.savez(f, **arrays)
 
 

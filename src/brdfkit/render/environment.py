@@ -292,11 +292,11 @@ _GENERATORS = {"sky": make_sky, "studio": make_studio, "furnace": make_furnace}
 # cache and files
 # ---------------------------------------------------------------------------------------------
 def cache_dir() -> Path:
-    """``$BRDFKIT_CACHE_DIR``, else ``$XDG_CACHE_HOME/brdfkit``, else ``~/.cache/brdfkit``."""
-    if os.environ.get("BRDFKIT_CACHE_DIR"):
-        return Path(os.environ["BRDFKIT_CACHE_DIR"])
-    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
-    return Path(base) / "brdfkit"
+    """``$BRDFKIT_CACHE_DIR``, else ``$XDG_CACHE_HOME/brdfkit``, else ``~/.cache/brdfkit``
+    (:func:`brdfkit.engine.cache.cache_root`: the built-in maps do not depend on the source version)."""
+    from ..engine.cache import cache_root
+
+    return cache_root()
 
 
 def builtin_map(name: str) -> np.ndarray:
