@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from . import engine, geometry, params, registry
+from . import engine, geometry, params, registry, sources
 from .engine import set_engine
 
 # ``models`` is the package brdfkit.models, made callable: ``bk.models()`` lists the
@@ -21,16 +21,26 @@ __version__ = "0.1.0"
 
 
 def model_info(name: str) -> dict[str, Any]:
-    """Name, title, reference, isotropy and the parameter table of a model."""
-    return registry.get(name).info()
+    """Name, title, reference, isotropy and the parameter table of a model (or a ``.brdf`` file)."""
+    return sources.model_class(name).info()
 
 
 def model(name: str, **params: Any) -> BRDF:
-    """An instance of model ``name`` with validated parameters (defaults for the rest)."""
-    return registry.get(name)(**params)
+    """The model ``name`` names, with validated parameters (defaults for the rest).
+
+    ``name`` is a registry name, a built-in measured material, or a file
+    (``.brdf``, MERL ``.binary``, a fit's ``.json``): see :mod:`brdfkit.sources`.
+    """
+    return sources.model(name, **params)
 
 
-__all__ = ["BRDF", "models", "model_info", "model", "geometry", "params", "registry", "engine", "set_engine", "__version__"]
+def load_measured(path) -> BRDF:
+    """A measured-data file as a model, its format told by its suffix (see :mod:`brdfkit.sources`)."""
+    return sources.load_measured(path)
+
+
+__all__ = ["BRDF", "models", "model_info", "model", "load_measured", "geometry", "params", "registry", "sources",
+           "engine", "set_engine", "__version__"]
 
 
 # -- measured data and fitting (brdfkit.measured; imported on first use) -------------

@@ -4,8 +4,7 @@ Every helper raises a one-line ``ValueError`` on bad input, which
 :func:`brdfkit.cli.main` prints as ``brdfkit: error: ...`` with a non-zero
 exit status (never a traceback).
 
-``model_from_cli(name, items)``  a model from its registry name and ``-p name=value`` strings
-                                 (or a measured material name / MERL file path)
+``model_from_cli(name, items)``  a model from any source (:mod:`brdfkit.sources`) and ``-p name=value`` strings
 ``parse_floats(text, n, what)``   ``"a,b,c"`` -> tuple of ``n`` finite floats
 ``parse_pair(text, what)``        ``"a,b"`` -> ``(a, b)``
 ``direction_from_degrees(text, what)``  ``"THETA,PHI"`` (degrees) -> unit vector
@@ -26,48 +25,16 @@ from .geometry import spherical_to_vector
 
 
 def model_from_cli(name: str, items: Iterable[str] | None = None):
-    """``bk.model(name, **parsed)`` where ``items`` are ``-p name=value`` strings.
+    """The model ``name`` names (:func:`brdfkit.sources.from_cli`), ``items`` being ``-p name=value`` strings.
 
-    Values are parsed against the model's parameter spec by
+    Values are parsed against the source's parameter spec by
     :func:`brdfkit.params.parse_assignments` (numbers, ``r,g,b``, true/false,
-    choices by name); unknown names, out-of-range or non-finite values raise a
-    one-line ``ValueError``.
+    choices by name); unknown names, out-of-range or non-finite values, and
+    ``-p`` given to measured data, raise a one-line ``ValueError``.
     """
-    import brdfkit as bk
-    from brdfkit.params import parse_assignments
-    from brdfkit.registry import get
+    from .sources import from_cli
 
-    items = list(items or ())
-    if name not in bk.models():
-        measured = _measured_from_cli(name, items)
-        if measured is not None:
-            return measured
-    cls = get(name)
-    given = parse_assignments(name, cls.spec, items)
-    return bk.model(name, **given)
-
-
-def _measured_from_cli(name: str, items: list[str]):
-    """A measured model for a MERL file path or a built-in material name; None if ``name`` is neither.
-
-    Measured data has no parameters, so ``-p`` is refused with a one-line error.
-    """
-    import os
-
-    import brdfkit as bk
-
-    if name.endswith(".brdf"):  # a BRDF Explorer shader: a model with parameters (registry.get)
-        return None
-    is_file = os.path.isfile(name) or name.endswith(".binary")
-    if not is_file:
-        from brdfkit.measured.nbrdf import materials
-
-        bare = {n.split("/", 1)[1] for n in materials()}
-        if name not in materials() and name not in bare:
-            return None
-    if items:
-        raise ValueError(f"{name}: measured data has no parameters; drop -p {items[0]}")
-    return bk.load_merl(name) if is_file else bk.material(name)
+    return from_cli(name, items)
 
 
 def parse_floats(text: str, n: int, what: str) -> tuple[float, ...]:

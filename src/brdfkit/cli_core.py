@@ -19,6 +19,7 @@ from typing import Any, List, Optional
 import numpy as np
 import typer
 
+from . import registry
 from .cli_common import (
     direction_from_degrees,
     direction_from_vector,
@@ -76,11 +77,10 @@ def _direction(angles: Optional[str], vec: Optional[str], name: str) -> np.ndarr
 
 def list_rows() -> list[dict[str, Any]]:
     """One row per registered model: name, title, reference, isotropic, parameter names."""
-    import brdfkit as bk
 
     rows = []
-    for name in bk.models():
-        info = bk.model_info(name)
+    for name in registry.names():
+        info = registry.get(name).info()
         rows.append(
             {
                 "name": info["name"],
@@ -172,15 +172,12 @@ def register(app: typer.Typer) -> None:
         json_: bool = typer.Option(False, "--json", help="Print the model info as JSON."),
     ) -> None:
         """Show a model's title, reference and parameter table (or what a measured material is)."""
-        import brdfkit as bk
+        from .sources import identify
 
-        if model not in bk.models():
-            from .cli_common import _measured_from_cli
-
-            measured = _measured_from_cli(model, [])
-            if measured is not None:
-                return _measured_info(model, measured, json_)
-        data = bk.model_info(model)
+        src = identify(model)
+        if src.is_measured:
+            return _measured_info(model, src.build(), json_)
+        data = src.model_class().info()
         if json_:
             print_json(data)
             return

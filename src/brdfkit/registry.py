@@ -1,7 +1,9 @@
 """Model registry: registry name -> model class.
 
-Model modules register themselves with :func:`register`; importing
-:mod:`brdfkit.models` imports every published model.
+Model modules register themselves with :func:`register`. Importing the
+package ``brdfkit`` imports :mod:`brdfkit.models`, which imports every
+published model, so the registry is full before any of its functions can be
+called; this module imports no model (the models import it: no cycle).
 """
 
 from __future__ import annotations
@@ -23,24 +25,17 @@ def register(cls: type["BRDF"]) -> type["BRDF"]:
     return cls
 
 
-def _ensure_loaded() -> None:
-    from . import models  # noqa: F401  (imports every model module)
-
-
 def names() -> list[str]:
     """Registry names, in registration order."""
-    _ensure_loaded()
     return list(_REGISTRY)
 
 
 def get(name: str) -> type["BRDF"]:
-    """The model class for ``name``; ``ValueError`` naming the valid choices otherwise."""
-    _ensure_loaded()
-    if isinstance(name, str) and name.endswith(".brdf") and name not in _REGISTRY:
-        # a BRDF Explorer file works wherever a model name does (brdfkit.interchange)
-        from .interchange.brdf_explorer import load_brdf_class
+    """The registered model class for ``name``; ``ValueError`` naming the valid choices otherwise.
 
-        return load_brdf_class(name)
+    Registered names only: files, measured materials and fits are resolved by
+    :mod:`brdfkit.sources`.
+    """
     if not isinstance(name, str) or name not in _REGISTRY:
         raise ValueError(f"unknown model {name!r}; valid models: {', '.join(_REGISTRY)}")
     return _REGISTRY[name]

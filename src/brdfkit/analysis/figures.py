@@ -12,7 +12,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-import brdfkit as bk
+from .. import sources
 
 from . import plots
 
@@ -20,22 +20,22 @@ from . import plots
 def albedo_models():
     """The README comparison: Phong, normalised Phong, Blinn-Phong, Cook-Torrance 1982, microfacet."""
     return [
-        (bk.model("phong", kd=0.0, ks=1.0, shininess=10.0, normalized=False), "Phong 1975 as a BRDF, (r·v)^10/cos θi"),
-        (bk.model("phong", kd=0.0, ks=1.0, shininess=10.0, normalized=True), "Phong normalised (Lewis 1994), s=10"),
+        (sources.model("phong", kd=0.0, ks=1.0, shininess=10.0, normalized=False), "Phong 1975 as a BRDF, (r·v)^10/cos θi"),
+        (sources.model("phong", kd=0.0, ks=1.0, shininess=10.0, normalized=True), "Phong normalised (Lewis 1994), s=10"),
         (
-            bk.model("blinn-phong", kd=0.0, ks=1.0, shininess=40.0, normalized=True),
+            sources.model("blinn-phong", kd=0.0, ks=1.0, shininess=40.0, normalized=True),
             "Blinn-Phong normalised, (s+8)/(8π)(n·h)^40",
         ),
-        (bk.model("cook-torrance", kd=0.0, ks=1.0, m=0.3, ior=10.0), "Cook-Torrance 1982, m=0.3, ior=10"),
+        (sources.model("cook-torrance", kd=0.0, ks=1.0, m=0.3, ior=10.0), "Cook-Torrance 1982, m=0.3, ior=10"),
         (
-            bk.model(
+            sources.model(
                 "microfacet", distribution="beckmann", alpha=0.3, shadowing="v-groove",
                 fresnel="dielectric", eta=10.0, k=0.0, kd=0.0, ks=1.0,
             ),
             "same, modern 1/(4 n·l n·v) form (Walter 2007)",
         ),
         (
-            bk.model("microfacet", distribution="ggx", alpha=0.3, shadowing="smith", fresnel="none", kd=0.0, ks=1.0),
+            sources.model("microfacet", distribution="ggx", alpha=0.3, shadowing="smith", fresnel="none", kd=0.0, ks=1.0),
             "microfacet GGX α=0.3, Smith G, no Fresnel",
         ),
     ]
@@ -75,25 +75,25 @@ def main(argv: list[str] | None = None) -> None:
     fig.axes[0].set_ylim(0, 4.5)
     plots.save_figure(fig, out / "albedo_curves.png")
     cmp = [
-        bk.model("phong", kd=0.1, ks=0.9, shininess=30.0),
-        bk.model("blinn-phong", kd=0.1, ks=0.9, shininess=120.0),
-        bk.model("microfacet", distribution="ggx", alpha=0.25, fresnel="none", kd=0.1, ks=0.9),
-        bk.model("cook-torrance", kd=0.1, ks=0.9, m=0.25, ior=1.5),
+        sources.model("phong", kd=0.1, ks=0.9, shininess=30.0),
+        sources.model("blinn-phong", kd=0.1, ks=0.9, shininess=120.0),
+        sources.model("microfacet", distribution="ggx", alpha=0.25, fresnel="none", kd=0.1, ks=0.9),
+        sources.model("cook-torrance", kd=0.1, ks=0.9, m=0.25, ior=1.5),
     ]
     plots.save_figure(plots.polar_plot(cmp, 60.0, log=True), out / "polar_example.png")
     plots.save_figure(
-        plots.lobe_plot([bk.model("ward", kd=0.1, ks=0.4, alpha_x=0.08, alpha_y=0.3), cmp[2]], 50.0),
+        plots.lobe_plot([sources.model("ward", kd=0.1, ks=0.4, alpha_x=0.08, alpha_y=0.3), cmp[2]], 50.0),
         out / "lobe_example.png",
     )
     plots.save_figure(plots.slice_plot([cmp[3], cmp[2]]), out / "slice_example.png")
     plots.save_figure(
         plots.sphere_plot(
             [
-                bk.model("lambert", kd=0.7),
-                bk.model("oren-nayar", kd=0.7, sigma=1.0),
+                sources.model("lambert", kd=0.7),
+                sources.model("oren-nayar", kd=0.7, sigma=1.0),
                 cmp[0],
-                bk.model("ward", kd=0.3, ks=0.3, alpha_x=0.05, alpha_y=0.3),
-                bk.model("microfacet", alpha=0.2),
+                sources.model("ward", kd=0.3, ks=0.3, alpha_x=0.05, alpha_y=0.3),
+                sources.model("microfacet", alpha=0.2),
             ],
             size=200,
         ),

@@ -8,6 +8,7 @@ from typing import Any, Iterable
 
 import numpy as np
 
+from .. import registry, sources
 from ..geometry import rotate_z
 from .albedo import DEFAULT_LEVEL, albedo_result
 from .reciprocity import RECIPROCITY_TOL, reciprocity_report
@@ -263,16 +264,12 @@ def stress_settings(name: str) -> list[dict[str, Any]]:
 
 def stress_jobs(names: Iterable[str] | None = None) -> list[tuple[str, dict[str, Any]]]:
     """``(model name, setting)`` pairs of ``check --all``: every model (or ``names``) × :func:`stress_settings`."""
-    import brdfkit as bk
-
-    return [(n, s) for n in (list(names) if names is not None else bk.models()) for s in stress_settings(n)]
+    return [(n, s) for n in (list(names) if names is not None else registry.names()) for s in stress_settings(n)]
 
 
 def _check_setting(name: str, setting: dict[str, Any], level: str) -> dict[str, Any]:
     """:func:`check` of one model at one setting, tagged with ``setting`` and ``changed``."""
-    import brdfkit as bk
-
-    r = check(bk.model(name, **setting), level=level)
+    r = check(sources.model(name, **setting), level=level)
     r["setting"] = "stress" if setting else "default"
     r["changed"] = {k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in setting.items()}
     return r

@@ -8,57 +8,19 @@
 
 from __future__ import annotations
 
-import json
-import os
-from typing import Any, List
+from typing import List
 
-import numpy as np
 import typer
 
 from ..cli_common import print_json
 
 
-def model_from_fit_json(path: str, items: List[str] | None = None):
-    """The fitted model of a ``brdfkit fit ... --json`` file (``-p`` items override its parameters)."""
-    import brdfkit as bk
-    from brdfkit.params import parse_assignments
-    from brdfkit.registry import get
-
-    try:
-        with open(path, encoding="utf-8") as fh:
-            obj = json.load(fh)
-    except OSError as e:
-        raise ValueError(f"{path}: cannot read: {e.strerror or e}") from None
-    except (json.JSONDecodeError, UnicodeDecodeError) as e:
-        raise ValueError(f"{path}: not valid JSON ({e})") from None
-    if isinstance(obj, list) and len(obj) == 1:
-        obj = obj[0]
-    if not isinstance(obj, dict) or not isinstance(obj.get("model"), str) or not isinstance(obj.get("params"), dict):
-        raise ValueError(f"{path}: expected the JSON of 'brdfkit fit ... --json' (an object with 'model' and 'params')")
-    name = obj["model"]
-    cls = get(name)
-    params: dict[str, Any] = {k: (np.asarray(v, dtype=np.float64) if isinstance(v, list) else v)
-                              for k, v in obj["params"].items() if v is not None}
-    params.update(parse_assignments(name, cls.spec, items or ()))
-    model = bk.model(name, **params)
-    src = obj.get("source")
-    try:
-        model.label = f"{name} fitted to {src}" if src else name
-    except AttributeError:  # pragma: no cover
-        pass
-    return model
-
-
 def source_model(source: str, items: List[str] | None = None):
-    """SOURCE of ``brdfkit export``: a model name or ``.brdf`` file, a measured material / MERL file,
-    or a fit's JSON (``brdfkit fit ... --json > fit.json``)."""
-    from ..cli_common import model_from_cli
+    """SOURCE of ``brdfkit export``: anything :mod:`brdfkit.sources` resolves (a model name or ``.brdf``
+    file, a measured material / MERL file, or a fit's JSON, whose parameters ``-p`` overrides)."""
+    from ..sources import from_cli
 
-    if source.lower().endswith(".json"):
-        if not os.path.isfile(source):
-            raise ValueError(f"{source}: no such file (a fit's JSON: brdfkit fit ... --json > {source})")
-        return model_from_fit_json(source, items)
-    return model_from_cli(source, items)
+    return from_cli(source, items)
 
 
 def register(app: typer.Typer) -> None:

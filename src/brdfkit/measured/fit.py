@@ -50,7 +50,6 @@ by the same probes, :func:`channel_groups`) take one evaluation for their three 
 from __future__ import annotations
 
 import math
-import os
 import time
 from contextlib import contextmanager
 from dataclasses import dataclass, field
@@ -61,7 +60,7 @@ import numpy as np
 from ..geometry import from_rusinkiewicz
 from ..models.base import BRDF
 from ..params import Param, to_jsonable
-from .merl import HALF_PI, MERLBRDF, RES_PHI_D, RES_THETA_D, RES_THETA_H, bin_centres, load_merl
+from .merl import HALF_PI, MERLBRDF, RES_PHI_D, RES_THETA_D, RES_THETA_H, bin_centres
 
 METRICS = ("ngan", "l2", "log", "cbrt")
 METRIC_TITLES = {
@@ -92,22 +91,11 @@ class Samples:
 
 
 def resolve_source(measured: Any) -> BRDF:
-    """A model from a MERL path, a built-in material name or a model instance."""
-    if isinstance(measured, BRDF):
-        return measured
-    if isinstance(measured, (str, os.PathLike)):
-        s = os.fspath(measured)
-        if os.path.exists(s) or s.endswith((".binary", ".bin")):
-            return load_merl(s)  # OSError if missing
-        from .nbrdf import SETS, material
+    """The data to fit: any source :func:`brdfkit.sources.resolve` takes (a measured material, a MERL
+    or other file, a fit's JSON, a model name or object)."""
+    from ..sources import resolve
 
-        looks_like_path = s.startswith((".", os.sep, "~")) or "." in os.path.basename(s) or (
-            os.sep in s and s.split(os.sep, 1)[0] not in SETS
-        )
-        if looks_like_path:
-            raise ValueError(f"{s}: no such MERL file (and not a built-in material; see `brdfkit list --measured`)")
-        return material(s)
-    raise ValueError(f"measured data must be a MERL file path, a material name or a model, got {type(measured).__name__}")
+    return resolve(measured)
 
 
 def _source_label(model: BRDF) -> str:

@@ -96,9 +96,9 @@ def register(app: typer.Typer) -> None:
 
             material = opengl.material_from_json(opengl_material)
         elif measured is not None:
-            from .. import measured as meas
+            from ..sources import MEASURED, resolve
 
-            material = meas.load_merl(measured) if Path(measured).is_file() else meas.material(measured)
+            material = resolve(measured, kinds=MEASURED)
         else:
             material = None
         if mesh is not None:

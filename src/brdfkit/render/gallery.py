@@ -36,7 +36,8 @@ from typing import Any, Callable, Sequence
 
 import numpy as np
 
-from .. import opengl
+from .. import opengl, sources
+from ..measured.nbrdf import material
 from ..geometry import normalize, reflect
 from ..opengl import Light, LightModel
 from .camera import DEFAULT_CAMERA, look_at
@@ -118,7 +119,6 @@ def _gouraud_vs_phong() -> list[Panel]:
 
 
 def _phong_vs_blinn() -> list[Panel]:
-    import brdfkit as bk
 
     sphere = {"builtin": "sphere", "segments": 96, "rings": 48}
     plane = {"builtin": "plane", "divisions": 64, "half_size": 4.0}
@@ -129,9 +129,9 @@ def _phong_vs_blinn() -> list[Panel]:
     key = [Light(position=(-1.0, 1.0, 1.0, 0.0), diffuse=(1, 1, 1))]
     kw = dict(kd=(0.05, 0.12, 0.3), ks=0.6)
     mats = [
-        ("Phong, s = 64", bk.model("phong", shininess=64, **kw)),
-        ("Blinn-Phong, s = 64", bk.model("blinn-phong", shininess=64, **kw)),
-        ("Blinn-Phong, s = 256", bk.model("blinn-phong", shininess=256, **kw)),
+        ("Phong, s = 64", sources.model("phong", shininess=64, **kw)),
+        ("Blinn-Phong, s = 64", sources.model("blinn-phong", shininess=64, **kw)),
+        ("Blinn-Phong, s = 256", sources.model("blinn-phong", shininess=256, **kw)),
     ]
     out = [Panel(c, sphere, m, "phong", FRONT, key, LightModel(ambient=0.1)) for c, m in mats]
     out += [Panel(c + ", grazing", plane, m, "phong", graze_cam, graze_light, LightModel(ambient=0.1), 0.3) for c, m in mats]
@@ -139,14 +139,13 @@ def _phong_vs_blinn() -> list[Panel]:
 
 
 def _lambert_vs_oren_nayar() -> list[Panel]:
-    import brdfkit as bk
 
     sphere = {"builtin": "sphere", "segments": 96, "rings": 48}
     kd = (0.75, 0.6, 0.45)
     mats = [
-        ("Lambert", bk.model("lambert", kd=kd)),
-        ("Oren-Nayar, σ = 0.35", bk.model("oren-nayar", kd=kd, sigma=0.35)),
-        ("Oren-Nayar, σ = 1.0", bk.model("oren-nayar", kd=kd, sigma=1.0)),
+        ("Lambert", sources.model("lambert", kd=kd)),
+        ("Oren-Nayar, σ = 0.35", sources.model("oren-nayar", kd=kd, sigma=0.35)),
+        ("Oren-Nayar, σ = 1.0", sources.model("oren-nayar", kd=kd, sigma=1.0)),
     ]
     head = [Light(position=(0.0, 0.0, 1.0, 0.0), diffuse=(1, 1, 1))]
     side = [Light(position=(-1.0, 0.3, 0.35, 0.0), diffuse=(1, 1, 1))]
@@ -170,7 +169,6 @@ METALS = {  # normal-incidence reflectance (linear RGB), commonly tabulated valu
 
 
 def _cook_torrance_metals() -> list[Panel]:
-    import brdfkit as bk
 
     teapot = {"builtin": "teapot", "subdivisions": 10}
     out = []
@@ -178,26 +176,25 @@ def _cook_torrance_metals() -> list[Panel]:
     # unreadable (copper pale pink-grey, silver = aluminium, 6 % of the pixels clipped); the
     # exposure 0.6 makes up for the 1982 formula's 1/π, 4x the modern 1/4 (docs/physics.md)
     for name, f0 in METALS.items():
-        m = bk.model("cook-torrance", kd=0.0, ks=1.0, m=0.2, ior=_ior_from_f0(f0))
+        m = sources.model("cook-torrance", kd=0.0, ks=1.0, m=0.2, ior=_ior_from_f0(f0))
         out.append(Panel(f"{name}, m = 0.2", teapot, m, "phong", TEAPOT_CAM, exposure=0.6, environment="studio",
                          samples=IBL_SAMPLES))
     for rough in (0.08, 0.15, 0.3, 0.5):
-        m = bk.model("cook-torrance", kd=0.0, ks=1.0, m=rough, ior=_ior_from_f0(METALS["gold"]))
+        m = sources.model("cook-torrance", kd=0.0, ks=1.0, m=rough, ior=_ior_from_f0(METALS["gold"]))
         out.append(Panel(f"gold, m = {rough:g}", teapot, m, "phong", TEAPOT_CAM, exposure=0.6, environment="studio",
                          samples=IBL_SAMPLES))
     return out
 
 
 def _ward() -> list[Panel]:
-    import brdfkit as bk
 
     sphere = {"builtin": "sphere", "segments": 96, "rings": 48}
     torus = {"builtin": "torus"}
     kw = dict(kd=(0.1, 0.1, 0.12), ks=0.25)
     mats = [
-        ("isotropic, α = 0.15", bk.model("ward", alpha_x=0.15, alpha_y=0.15, **kw)),
-        ("brushed, αx = 0.04, αy = 0.4", bk.model("ward", alpha_x=0.04, alpha_y=0.4, **kw)),
-        ("brushed, αx = 0.4, αy = 0.04", bk.model("ward", alpha_x=0.4, alpha_y=0.04, **kw)),
+        ("isotropic, α = 0.15", sources.model("ward", alpha_x=0.15, alpha_y=0.15, **kw)),
+        ("brushed, αx = 0.04, αy = 0.4", sources.model("ward", alpha_x=0.04, alpha_y=0.4, **kw)),
+        ("brushed, αx = 0.4, αy = 0.04", sources.model("ward", alpha_x=0.4, alpha_y=0.04, **kw)),
     ]
     lights = [Light(position=(-2.0, 2.5, 3.0, 1.0), diffuse=(1, 1, 1))]
     lm = LightModel(ambient=0.1)
@@ -217,15 +214,14 @@ IBL_SAMPLES = 64
 
 
 def _metals_ibl() -> list[Panel]:
-    import brdfkit as bk
 
     teapot = {"builtin": "teapot", "subdivisions": 10}
     out = []
     for name, (eta, k) in CONDUCTORS.items():
-        m = bk.model("microfacet", alpha=0.12, eta=eta, k=k, multiscatter=True)
+        m = sources.model("microfacet", alpha=0.12, eta=eta, k=k, multiscatter=True)
         out.append(Panel(f"{name}, α = 0.12", teapot, m, "phong", TEAPOT_CAM, environment="studio", samples=IBL_SAMPLES))
     for name in ("merl/chrome", "merl/brass", "merl/aluminium", "merl/nickel"):
-        out.append(Panel(name.split("/", 1)[1] + " (measured)", teapot, bk.material(name), "phong", TEAPOT_CAM,
+        out.append(Panel(name.split("/", 1)[1] + " (measured)", teapot, material(name), "phong", TEAPOT_CAM,
                          environment="studio", samples=IBL_SAMPLES))
     return out
 
@@ -234,7 +230,6 @@ FURNACE_ALPHAS = (0.25, 0.5, 0.75, 1.0)
 
 
 def _white_furnace() -> list[Panel]:
-    import brdfkit as bk
     from .scene import Look
 
     sphere = {"builtin": "sphere", "segments": 96, "rings": 48}
@@ -242,7 +237,7 @@ def _white_furnace() -> list[Panel]:
     out = []
     for ms in (False, True):
         for a in FURNACE_ALPHAS:
-            m = bk.model("microfacet", alpha=a, fresnel="none", multiscatter=ms)
+            m = sources.model("microfacet", alpha=a, fresnel="none", multiscatter=ms)
             cap = f"α = {a:g}, " + ("multiple scattering" if ms else "single scattering")
             out.append(Panel(cap, sphere, m, "phong", FRONT, environment="furnace", samples=IBL_SAMPLES, look=look))
     return out
@@ -260,12 +255,11 @@ MEASURED = (
 
 
 def _measured() -> list[Panel]:
-    import brdfkit as bk
 
     sphere = {"builtin": "sphere", "segments": 96, "rings": 48}
     # lit by the studio environment: under the former two point lights chrome-steel (a near
     # mirror) was black but for one tiny highlight
-    return [Panel(name.split("/", 1)[1], sphere, bk.material(name), "phong", FRONT, environment="studio",
+    return [Panel(name.split("/", 1)[1], sphere, material(name), "phong", FRONT, environment="studio",
                   samples=IBL_SAMPLES) for name in MEASURED]
 
 

@@ -142,27 +142,27 @@ def material_from_spec(spec: Any) -> Any:
     if "measured" in spec or "merl" in spec:
         if len(spec) != 1:
             raise ValueError("material with 'measured' or 'merl' takes no other field")
-        from .. import measured
+        from ..sources import MEASURED, resolve
 
         if "measured" in spec:
             if not isinstance(spec["measured"], str):
                 raise ValueError(f"material 'measured' must be a material name (a string), got {spec['measured']!r}")
-            return measured.material(spec["measured"])
+            return resolve(spec["measured"], kinds=MEASURED)
         if not isinstance(spec["merl"], (str, os.PathLike)) or not str(spec["merl"]):
             raise ValueError(f"material 'merl' must be a file name (a string), got {spec['merl']!r}")
-        return measured.load_merl(spec["merl"])
+        return resolve(spec["merl"], kinds=("merl",))
     if "model" in spec:
         extra = set(spec) - {"model", "params"}
         if extra:
             raise ValueError(f"material: unknown field(s) {', '.join(sorted(extra))}; use model and params")
-        import brdfkit as bk
+        from ..sources import resolve
 
         params = spec.get("params", {}) or {}
         if not isinstance(spec["model"], str):
             raise ValueError(f"material 'model' must be a model name (a string), got {spec['model']!r}")
         if not isinstance(params, Mapping):
             raise ValueError("material params must be an object of name: value")
-        return bk.model(spec["model"], **{str(k): v for k, v in params.items()})
+        return resolve(spec["model"], {str(k): v for k, v in params.items()})
     raise ValueError(_MATERIAL_FORMS)
 
 
