@@ -12,6 +12,7 @@ Kinds of source, in the order they are tried
 ``brdf``      a Disney BRDF Explorer ``.brdf`` file (its GLSL); takes parameters
 ``fit``       a fit's JSON (``brdfkit fit ... --json > fit.json``); parameters override the fitted ones
 ``merl``      a MERL ``.binary`` file (Matusik et al. 2003); also any existing file of another suffix
+``rgl``       an RGL ``.bsdf`` file (Dupuy & Jakob 2018, as Mitsuba 3's ``measured`` reads it)
 
 File kinds are chosen by suffix (:data:`FILE_KINDS`, case-insensitive). Measured
 data (``material``, ``merl``) takes no parameters. :func:`resolve` with
@@ -38,9 +39,9 @@ from .params import parse_assignments
 #: kinds that take parameters (a parameter table to parse ``-p`` against)
 PARAMETRIC = ("model", "brdf", "fit")
 #: kinds that are measured data (no parameters)
-MEASURED = ("material", "merl")
+MEASURED = ("material", "merl", "rgl")
 #: kinds read from a file
-FILES = ("brdf", "fit", "merl")
+FILES = ("brdf", "fit", "merl", "rgl")
 
 
 @dataclass(frozen=True)
@@ -108,6 +109,12 @@ def _build_merl(path: str, params: dict) -> BRDF:
     return load_merl(path)
 
 
+def _build_rgl(path: str, params: dict) -> BRDF:
+    from .measured.rgl import load_rgl
+
+    return load_rgl(path)
+
+
 def _read_fit_json(path: str) -> tuple[str, dict[str, Any], str | None]:
     """(model name, fitted parameters, source label) of a ``brdfkit fit ... --json`` file."""
     try:
@@ -140,10 +147,11 @@ _BUILDERS: dict[str, Callable[[str, dict], BRDF]] = {
     "brdf": _build_brdf,
     "fit": _build_fit,
     "merl": _build_merl,
+    "rgl": _build_rgl,
 }
 
 #: file suffix (lower case) -> kind. A reader of a new format adds its suffix here and its builder above.
-FILE_KINDS: dict[str, str] = {".brdf": "brdf", ".json": "fit", ".binary": "merl", ".bin": "merl"}
+FILE_KINDS: dict[str, str] = {".brdf": "brdf", ".json": "fit", ".binary": "merl", ".bin": "merl", ".bsdf": "rgl"}
 #: what an existing file of no known suffix is read as (MERL's reader checks its header and size)
 DEFAULT_FILE_KIND = "merl"
 
@@ -269,6 +277,7 @@ def load_measured(path: str | os.PathLike) -> BRDF:
 _MISSING = {
     "brdf": "no such .brdf file",
     "merl": "no such MERL file",
+    "rgl": "no such RGL .bsdf file",
     "fit": "no such file (a fit's JSON: brdfkit fit ... --json > FILE)",
     None: "no such file (nor a model or a built-in measured material: see `brdfkit list`, `brdfkit list --measured`)",
 }
@@ -280,6 +289,7 @@ _KIND_WORDS = {
     "brdf": "a BRDF Explorer .brdf file",
     "fit": "a fit's JSON",
     "merl": "a MERL .binary file",
+    "rgl": "an RGL .bsdf file",
 }
 
 __all__ = ["Source", "identify", "resolve", "model", "from_cli", "model_class", "load_measured",
