@@ -192,6 +192,18 @@ def test_contract_float32_horizon_finite(tmp_path):
     np.testing.assert_allclose(grid[3, 7], m.eval(wi[3], wo[7]), rtol=1e-12)
 
 
+def test_large_batches_equal_small_ones(tmp_path):
+    """The evaluation runs in blocks: a batch larger than one block gives the same values."""
+    from brdfkit.measured import rgl
+
+    m = load_rgl(write(tmp_path, "big.bsdf", n_phi=3, reduction=4))
+    n = 2 * rgl._CHUNK + 123
+    wi, wo = random_pairs(n, 9)
+    f = m.eval(wi, wo)
+    for a in (0, rgl._CHUNK - 5, n - 40):
+        np.testing.assert_array_equal(f[a:a + 40], m.eval(wi[a:a + 40], wo[a:a + 40]))
+
+
 def test_negative_table_values_are_clamped(tmp_path):
     f = rgl_fields()
     f["rgb"][..., 0, :, :] = -1.0

@@ -85,6 +85,7 @@ REQUIRED = ("theta_i", "phi_i", "ndf", "sigma", "vndf", "luminance", "descriptio
 MAX_TABLE_BYTES = 4 << 30
 #: values are clamped to [0, this]: an absurd table must not give inf in float32
 _FLOAT32_MAX = float(np.finfo(np.float32).max)
+_CHUNK = 1 << 14  # pairs per block of the vectorised evaluation
 
 
 # ----------------------------------------------------------------- the unit-square maps
@@ -114,19 +115,19 @@ class _Params:
         ip, wp = _interval(phi_values, phi)
         it, wt = _interval(theta_values, theta)
         npf, nt = len(phi_values), len(theta_values)
-        # the four (φ, θ) corners: slice index and weight, shape (4, n); a parameter of
-        # size 1 has stride 0 (its second corner is the first, with weight 0)
-        ips = (ip, np.minimum(ip + 1, npf - 1))
-        its = (it, np.minimum(it + 1, nt - 1))
-        self.slices = np.stack([ips[a] * nt + its[b] for a in (0, 1) for b in (0, 1)])
-        self.weights = np.stack([wp[a] * wt[b] for a in (0, 1) for b in (0, 1)])
+        # the (φ, θ) corners: slice index and weight, shape (corners, n); a parameter of size 1
+        # has one corner (Mitsuba: stride 0, the second corner the first with weight 0)
+        pa = (0, 1) if npf > 1 else (0,)
+        tb = (0, 1) if nt > 1 else (0,)
+        self.slices = np.stack([(ip + a) * nt + (it + b) for a in pa for b in tb])
+        self.weights = np.stack([wp[a] * wt[b] for a in pa for b in tb])
 
     def lookup(self, table: np.ndarray, index) -> np.ndarray:
         """``table[slice, index]`` interpolated over the corners; ``table`` is ``(slices, k)`` or
         ``(slices, k, channels)`` (then the result is ``(n, channels)``)."""
         extra = (slice(None),) + (None,) * (table.ndim - 2)
         out = self.weights[0][extra] * table[self.slices[0], index]
-        for j in range(1, 4):
+        for j in range(1, len(self.slices)):
             out += self.weights[j][extra] * table[self.slices[j], index]
         return out
 
@@ -383,8 +384,17 @@ class RGLBRDF(MeasuredBRDF):
 
     def _eval(self, wi, wo, p):
         shape = np.broadcast_shapes(np.shape(wi), np.shape(wo))
-        l = np.array(np.broadcast_to(wi, shape), dtype=np.float64).reshape(-1, 3)
-        v = np.array(np.broadcast_to(wo, shape), dtype=np.float64).reshape(-1, 3)
+        l = np.broadcast_to(wi, shape).reshape(-1, 3)
+        v = np.broadcast_to(wo, shape).reshape(-1, 3)
+        out = np.empty((len(l), 3))
+        for a in range(0, len(l), _CHUNK):  # blocks small enough for the caches
+            out[a:a + _CHUNK] = self._eval_flat(l[a:a + _CHUNK], v[a:a + _CHUNK])
+        return out.reshape(shape)
+
+    def _eval_flat(self, wi: np.ndarray, wo: np.ndarray) -> np.ndarray:
+        """Steps 1-5 of the module docstring on ``(n, 3)`` directions above the horizon."""
+        l = np.array(wi, dtype=np.float64)
+        v = np.array(wo, dtype=np.float64)
         cos_l = l[:, 2].copy()
         self._fold(v, l)
         m = v + l
@@ -408,7 +418,7 @@ class RGLBRDF(MeasuredBRDF):
             u_i = np.stack([theta2u(theta_i), phi2u(phi_i)], axis=1)
             f *= (_bilinear(self._ndf, u_m) / (4.0 * _bilinear(self._sigma, u_i)))[:, None]
         f = _safe_div(f, cos_l[:, None])
-        return np.clip(f, 0.0, _FLOAT32_MAX).reshape(shape)
+        return np.clip(f, 0.0, _FLOAT32_MAX)
 
 
 def load_rgl(path: str | os.PathLike) -> RGLBRDF:
