@@ -10,7 +10,6 @@ Mitsuba (``scalar_rgb``, float32) is the independent reader: on 2000 random pair
 
 from __future__ import annotations
 
-import os
 import struct
 import tracemalloc
 
