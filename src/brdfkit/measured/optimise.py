@@ -22,6 +22,7 @@ from __future__ import annotations
 import math
 import time
 from contextlib import contextmanager
+from dataclasses import dataclass
 from typing import Any, Callable, Mapping
 
 import numpy as np
@@ -228,27 +229,9 @@ def fit(
     Returns a :class:`FitResult` (``params`` holds every parameter of the model;
     ``at_bound`` lists the free values that ended on a fitting bound).
     """
-    from .. import registry
-
     t0 = time.perf_counter()
-    if metric not in METRICS:
-        raise ValueError(f"unknown metric {metric!r}; valid metrics: {', '.join(METRICS)}")
-    if starts < 1:
-        raise ValueError(f"starts must be at least 1, got {starts}")
-    is_table = isinstance(samples, str)
-    if is_table and samples != "table":
-        raise ValueError(f"samples must be a number of samples or 'table', got {samples!r}")
-    if not is_table and (isinstance(samples, bool) or not isinstance(samples, (int, np.integer))):
-        raise ValueError(f"samples must be a number of samples or 'table', got {samples!r}")
-    if isinstance(lobes, bool) or lobes not in (1, 2):
-        raise ValueError(f"lobes must be 1 or 2, got {lobes!r}")
-    cls = name if isinstance(name, type) and issubclass(name, BRDF) else registry.get(name)
-    fixed = dict(fixed or {})
-    if lobes == 2:
-        if any(p.name == "lobes" for p in cls.spec):
-            fixed.setdefault("lobes", 2)
-        else:
-            cls = two_lobe(cls)
+    is_table = _check_options(metric, starts, samples, lobes)
+    cls, fixed = _model_class(name, lobes, fixed)
     packer = ParamPacker(cls, fixed)
     if data is None:
         data = table(measured, max_theta_deg) if is_table else sample(measured, n=samples, seed=seed,
@@ -256,12 +239,6 @@ def fit(
     search = subsample(data, TABLE_SEARCH_SAMPLES, seed) if is_table else data
     T = transform(metric)
     residuals = residual_fn(packer, search, T, metric)
-
-    def cost(x: np.ndarray) -> float:
-        r = residuals(x)
-        return float(r @ r)
-
-    nfev = 0
     if len(packer) == 0:  # nothing free: just evaluate
         model = packer.model(np.zeros(0))
         err = error(model, data, metric)
@@ -269,34 +246,17 @@ def fit(
                          time.perf_counter() - t0, sorted(packer.fixed_names), [], [err], lobes=lobes,
                          search_samples=len(search))
     # from here on the model is built from the free values
-    rng = np.random.default_rng(seed + 1)
-    nfev += 2 * (len(packer) + 1)  # freeze_unused: at most 2 points × (base + one probe per slot)
-    with _engine_threads(len(search)):
-        freeze_unused(packer, residuals, rng)
-        x_default = packer.x_of(packer.fixed)
-        cand = [x_default]
-        if candidates > 0:
-            cand += list(packer.random_x(rng, candidates))
-        costs = np.array([cost(x) for x in cand])
-        # Jacobian columns known once for all (a float32-evaluated model's differences are too noisy)
-        const, groups = {}, None
-        if not getattr(cls, "fit_diff_step", None):
-            probes = probe_columns(residuals, packer, cand[:2])
-            nfev += probes.evaluations
-            const = constant_columns(residuals, packer, cand[:2], probes)
-            groups = channel_groups(residuals, packer, cand[:2], const, probes)
-    nfev += len(cand)
-    order = [0] + [int(i) for i in np.argsort(costs) if i != 0]
-    chosen = order[:starts]
-
-    total = len(chosen) + (1 if search is not data else 0)
+    plan = _plan_starts(packer, residuals, len(search), seed, candidates, starts)
+    nfev = plan.evaluations
+    total = len(plan.chosen) + (1 if search is not data else 0)
     best_x, best_cost = None, math.inf
     start_errors = []
     known: list[tuple[np.ndarray, float]] = []  # the minima the starts converged to
     with fit_progress(progress, f"fit {cls.name} ← {data.source}", total) as step:
-        for n_done, ci in enumerate(chosen, 1):
+        for n_done, x0 in enumerate(plan.chosen, 1):
             with _engine_threads(len(search)):
-                x, cst, used, joined = _local(residuals, cand[ci], packer, max_nfev or 100, tol, known, const, groups)
+                x, cst, used, joined = _local(residuals, x0, packer, max_nfev or 100, tol, known, plan.const,
+                                              plan.groups)
             nfev += used
             start_errors.append(math.sqrt(cst))
             if not joined:
@@ -312,10 +272,75 @@ def fit(
     model = packer.cls(**flush_subnormal(packer.params(best_x)))
     err = error(model, data, metric)
     return FitResult(
-        model, dict(model.params), err, metric, data.source, len(data), len(chosen), nfev,
+        model, dict(model.params), err, metric, data.source, len(data), len(plan.chosen), nfev,
         time.perf_counter() - t0, sorted(packer.fixed_names), list(packer.frozen), start_errors,
         len(packer), slots_at_bound(packer, best_x), lobes, len(search),
     )
 
+
+def _check_options(metric: str, starts: int, samples: int | str, lobes: int) -> bool:
+    """One-line ``ValueError`` for a bad option of :func:`fit`; whether ``samples`` is ``"table"``."""
+    if metric not in METRICS:
+        raise ValueError(f"unknown metric {metric!r}; valid metrics: {', '.join(METRICS)}")
+    if starts < 1:
+        raise ValueError(f"starts must be at least 1, got {starts}")
+    is_table = isinstance(samples, str)
+    if is_table and samples != "table":
+        raise ValueError(f"samples must be a number of samples or 'table', got {samples!r}")
+    if not is_table and (isinstance(samples, bool) or not isinstance(samples, (int, np.integer))):
+        raise ValueError(f"samples must be a number of samples or 'table', got {samples!r}")
+    if isinstance(lobes, bool) or lobes not in (1, 2):
+        raise ValueError(f"lobes must be 1 or 2, got {lobes!r}")
+    return is_table
+
+
+def _model_class(name: str | type[BRDF], lobes: int, fixed: Mapping[str, Any] | None
+                 ) -> tuple[type[BRDF], dict[str, Any]]:
+    """The class :func:`fit` fits and its fixed values: with ``lobes=2`` a model's own ``lobes``
+    parameter set to 2 (Lafortune), else the :func:`~brdfkit.measured.lobes.two_lobe` class."""
+    from .. import registry
+
+    cls = name if isinstance(name, type) and issubclass(name, BRDF) else registry.get(name)
+    fixed = dict(fixed or {})
+    if lobes == 2:
+        if any(p.name == "lobes" for p in cls.spec):
+            fixed.setdefault("lobes", 2)
+        else:
+            cls = two_lobe(cls)
+    return cls, fixed
+
+
+@dataclass
+class _StartPlan:
+    """Where the local runs of a fit start, and what they know of the Jacobian beforehand."""
+
+    chosen: list[np.ndarray]  # the starting points, the defaults first
+    const: dict[int, np.ndarray]  # constant_columns
+    groups: list[list[int]] | None  # channel_groups
+    evaluations: int  # residual evaluations spent choosing (counted as before: an upper bound)
+
+
+def _plan_starts(packer: ParamPacker, residuals, n_samples: int, seed: int, candidates: int, starts: int
+                 ) -> _StartPlan:
+    """Freeze the unused slots, then take the defaults and the best ``starts - 1`` of ``candidates``
+    random points (by cost), and probe the Jacobian's columns at the first two of them."""
+    rng = np.random.default_rng(seed + 1)
+    nfev = 2 * (len(packer) + 1)  # freeze_unused: at most 2 points × (base + one probe per slot)
+    with _engine_threads(n_samples):
+        freeze_unused(packer, residuals, rng)
+        cand = [packer.x_of(packer.fixed)]
+        if candidates > 0:
+            cand += list(packer.random_x(rng, candidates))
+        costs = np.array([float(r @ r) for r in map(residuals, cand)])
+        # Jacobian columns known once for all (a float32-evaluated model's differences are too noisy)
+        const, groups = {}, None
+        if not getattr(packer.cls, "fit_diff_step", None):
+            probes = probe_columns(residuals, packer, cand[:2])
+            nfev += probes.evaluations
+            const = constant_columns(residuals, packer, cand[:2], probes)
+            groups = channel_groups(residuals, packer, cand[:2], const, probes)
+    nfev += len(cand)
+    order = [0] + [int(i) for i in np.argsort(costs) if i != 0]
+    return _StartPlan([cand[i] for i in order[:starts]], const, groups, nfev)
 
 __all__ = ["fit", "JOIN_XTOL", "JOIN_RTOL", "TABLE_SEARCH_SAMPLES", "SERIAL_SAMPLES", "POLISH_ITERATIONS"]
