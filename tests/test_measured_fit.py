@@ -248,7 +248,9 @@ def test_starts_joining_a_known_basin_stop_early_and_lose_nothing(monkeypatch):
     data = F.sample("merl/gold-metallic-paint", n=800, seed=2)
     kw = dict(fixed={"distribution": "ggx", "fresnel": "schlick"}, data=data, seed=2)
     joined = F.fit("microfacet", "merl/gold-metallic-paint", **kw)
-    monkeypatch.setattr(F, "JOIN_XTOL", 0.0)  # no start can join: each runs to convergence
+    from brdfkit.measured import optimise
+
+    monkeypatch.setattr(optimise, "JOIN_XTOL", 0.0)  # no start can join: each runs to convergence
     full = F.fit("microfacet", "merl/gold-metallic-paint", **kw)
     assert joined.nfev < full.nfev
     assert joined.error <= full.error * (1 + 1e-6)

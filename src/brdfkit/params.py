@@ -90,6 +90,10 @@ class Param:
     ``fit_range`` optionally narrows the range used as fitting bounds (e.g. an
     exponent that may be 0 but is fitted within [1, 1e5]).
     ``fit`` says whether the fitter may vary it (choices and bools never are).
+    ``tie`` names this parameter's isotropic twin: when the (anisotropic) model is fitted
+    to isotropic data, this parameter takes the twin's value instead of a free value of its
+    own (``alpha_y`` with ``tie="alpha_x"``: one roughness). Only a ``scalar`` may be tied,
+    to another ``scalar`` of the same spec that is not tied itself (:func:`isotropic_ties`).
     """
 
     name: str
@@ -104,10 +108,13 @@ class Param:
     fit: bool = True
     fit_range: tuple[float, float] | None = None
     log_scale: bool = False  # UI / fitting hint: the parameter spans decades
+    tie: str = ""  # fitting to isotropic data: the parameter whose value this one shares
 
     def __post_init__(self) -> None:
         if self.kind not in KINDS:
             raise TypeError(f"unknown parameter kind {self.kind!r}")
+        if self.tie and (self.kind != "scalar" or self.tie == self.name):
+            raise TypeError(f"parameter {self.name}: tie={self.tie!r} needs a scalar tied to another parameter")
         if self.kind == "choice" and self.default not in self.choices:
             raise TypeError(f"default {self.default!r} of {self.name} not among {self.choices}")
 
@@ -266,6 +273,33 @@ def validate(model: str, spec: ParamSpec, given: Mapping[str, Any]) -> dict[str,
     return out
 
 
+def isotropic_ties(model: str, spec: ParamSpec) -> dict[str, str]:
+    """The spec's declared ties (:attr:`Param.tie`) as ``{twin: tied parameter}``: the pairs that
+    share one free value when the model is fitted to isotropic data (``{"alpha_x": "alpha_y"}``).
+
+    Raises a one-line ``ValueError`` naming the model when a tie names no parameter of the spec,
+    a parameter of another kind, a parameter that is tied itself, or a twin tied twice.
+    """
+    by_name = {p.name: p for p in spec}
+    out: dict[str, str] = {}
+    for p in spec:
+        if not p.tie:
+            continue
+        twin = by_name.get(p.tie)
+        if twin is None:
+            raise ValueError(f"{model}: parameter '{p.name}' is tied to '{p.tie}', "
+                             "which is not a parameter of the model")
+        if twin.kind != p.kind:
+            raise ValueError(f"{model}: parameter '{p.name}' ({p.kind}) is tied to '{twin.name}' ({twin.kind}); "
+                             "a tie needs two parameters of the same kind")
+        if twin.tie:
+            raise ValueError(f"{model}: parameter '{p.name}' is tied to '{twin.name}', which is tied itself")
+        if twin.name in out:
+            raise ValueError(f"{model}: parameters '{out[twin.name]}' and '{p.name}' are both tied to '{twin.name}'")
+        out[twin.name] = p.name
+    return out
+
+
 def parse_value(model: str, param: Param, text: str) -> Any:
     """Parse the text of ``-p name=value`` for ``param`` (numbers, ``r,g,b``, true/false, choices)."""
     text = text.strip()
@@ -335,9 +369,10 @@ def ks_param(default: Any = 0.5, doc: str = "specular weight", hi: float = 1.0) 
     return Param("ks", "rgb", default, (0.0, hi), "", doc)
 
 
-def exponent_param(name: str, default: float, doc: str) -> Param:
-    """A cosine-power exponent (Phong shininess, Ashikhmin-Shirley n_u/n_v): [0, 1e5], fitted in all of [1, 1e5]."""
-    return Param(name, "scalar", default, (0.0, 1e5), "", doc, fit_range=(1.0, 1e5), log_scale=True)
+def exponent_param(name: str, default: float, doc: str, tie: str = "") -> Param:
+    """A cosine-power exponent (Phong shininess, Ashikhmin-Shirley n_u/n_v): [0, 1e5], fitted in all of [1, 1e5].
+    ``tie``: its isotropic twin (:attr:`Param.tie`), e.g. n_v's n_u."""
+    return Param(name, "scalar", default, (0.0, 1e5), "", doc, fit_range=(1.0, 1e5), log_scale=True, tie=tie)
 
 
 __all__ = [
@@ -349,6 +384,7 @@ __all__ = [
     "parse_assignments",
     "to_jsonable",
     "spec_names",
+    "isotropic_ties",
     "kd_param",
     "ks_param",
     "exponent_param",

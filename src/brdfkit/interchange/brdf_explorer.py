@@ -62,7 +62,7 @@ from __future__ import annotations
 import math
 import os
 import re
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, ClassVar
 
@@ -79,6 +79,18 @@ _IDENT = re.compile(r"[A-Za-z_][A-Za-z0-9_]*\Z")
 _BRDF_DEF = re.compile(r"\b(vec3|float)\s+BRDF\s*\(")
 _GLSL_TYPES = {"scalar": "float", "rgb": "vec3", "bool": "bool"}
 _SECTIONS = ("parameters", "shader", "isFunc")
+#: anisotropic pairs by their conventional names (Disney's ward.brdf: alpha_x/alpha_y, ashikhman_shirley.brdf:
+#: n_u/n_v, ...): a file declares no ties, so the second float of a pair it has is tied to the first
+#: (Param.tie), one value when the file's model is fitted to isotropic data, as brdfkit's own models declare
+ISOTROPIC_PAIRS = (("alpha_x", "alpha_y"), ("nu", "nv"), ("n_u", "n_v"), ("alpha_u", "alpha_v"), ("m_x", "m_y"),
+                   ("cx_1", "cy_1"), ("cx_2", "cy_2"), ("cx_3", "cy_3"))
+
+
+def _tie_pairs(params: tuple[Param, ...]) -> tuple[Param, ...]:
+    """``params`` with the second float of each of :data:`ISOTROPIC_PAIRS` present tied to the first."""
+    floats = {p.name for p in params if p.kind == "scalar"}
+    twin = {b: a for a, b in ISOTROPIC_PAIRS if a in floats and b in floats}
+    return tuple(replace(p, tie=twin[p.name]) if p.name in twin else p for p in params)
 
 
 @dataclass(frozen=True)
@@ -266,7 +278,7 @@ def parse_brdf_text(text: str, name: str = "<file>") -> BrdfShader:
     if m is None:
         raise _err(name, shader_line, "the shader section defines no 'vec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y)'")
     returns = m.group(1)
-    ptuple = tuple(params)
+    ptuple = _tie_pairs(tuple(params))
     return BrdfShader(
         name=name,
         params=ptuple,

@@ -24,7 +24,7 @@ therefore loses at most the fits in flight. ``resume=True`` skips every job whos
 already there with the same settings. When the batch ends (also on Ctrl-C: then with
 blank cells), the tables are written from those files: ``fit_errors.csv`` (columns
 ``material,<model>,...``), ``fit_params.json`` (one object per fit, the fields of
-:meth:`~brdfkit.measured.fit.FitResult.to_json` plus ``column``), ``fit_errors.md``
+:meth:`~brdfkit.measured.result.FitResult.to_json` plus ``column``), ``fit_errors.md``
 (the table, median/mean/best-on rows, mean rank, and every fit that ended on a fitting
 bound), ``fit_errors_sorted.png`` (each model's errors sorted) and
 ``fit_errors_by_material.png`` (all models per material, materials sorted by the best
@@ -47,6 +47,7 @@ from typing import Any, Callable, Iterable, Mapping
 import numpy as np
 
 from ..fileio import check_output_path, write_json, write_text, atomic_path
+from .result import FitResult
 
 
 # --------------------------------------------------------------------------- jobs
@@ -83,7 +84,7 @@ def _safe(s: str) -> str:
 
 @lru_cache(maxsize=4)
 def _data(source: str, samples: int | str, seed: int, max_theta_deg: float):
-    from .fit import sample, table
+    from .samples import sample, table
 
     if samples == "table":
         return table(source, max_theta_deg)
@@ -93,7 +94,7 @@ def _data(source: str, samples: int | str, seed: int, max_theta_deg: float):
 def fit_task(job: Job) -> dict[str, Any]:
     """Run one fit (in a worker); returns the JSON record stored for it."""
     os.environ.setdefault("OMP_NUM_THREADS", "1")
-    from .fit import fit
+    from .optimise import fit
 
     data = _data(job.source, job.samples, job.seed, job.max_theta_deg)
     r = fit(job.model, job.source, fixed=dict(job.fixed), metric=job.metric, starts=job.starts,
@@ -126,6 +127,50 @@ def _hashable(v: Any) -> Any:
     if isinstance(v, list):
         return tuple(v)
     return v
+
+
+# --------------------------------------------------------------------------- in one process
+def fit_batch(
+    names: Iterable[str],
+    sources: Iterable[str],
+    metric: str = "ngan",
+    fixed: Mapping[str, Mapping[str, Any]] | None = None,
+    progress: bool = True,
+    **kw: Any,
+) -> list[FitResult]:
+    """Fit every model in ``names`` to every source, one after the other in this process (no
+    files written; :func:`run_batch` is the crash-safe, parallel batch); the samples of a source
+    are shared by the models. ``kw``: :func:`~brdfkit.measured.optimise.fit`'s keywords."""
+    from rich.console import Console
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
+
+    from .optimise import fit
+    from .samples import sample, table
+
+    names = list(names)
+    sources = list(sources)
+    fixed = fixed or {}
+    out: list[FitResult] = []
+    samp_kw = {k: kw.pop(k) for k in ("samples", "seed", "max_theta_deg") if k in kw}
+    n_samp = samp_kw.pop("samples", 3000)
+    log_lines = progress and not sys.stderr.isatty()  # a log file: one plain line per material
+    t0 = time.perf_counter()
+    with Progress(
+        TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
+        TimeRemainingColumn(), console=Console(stderr=True), disable=not progress or log_lines,
+    ) as bar:
+        task = bar.add_task("fitting", total=len(names) * len(sources))
+        for n_src, src in enumerate(sources, 1):
+            if log_lines:
+                print(f"[{n_src}/{len(sources)}] {src} ({time.perf_counter() - t0:.0f} s)", file=sys.stderr, flush=True)
+            data = (table(src, samp_kw.get("max_theta_deg", 80.0)) if n_samp == "table"
+                    else sample(src, n=n_samp, **samp_kw))
+            for nm in names:
+                bar.update(task, description=f"{nm:>18} ← {data.source}")
+                out.append(fit(nm, src, fixed=fixed.get(nm), metric=metric, data=data, samples=n_samp,
+                               seed=samp_kw.get("seed", 0), **kw))
+                bar.update(task, advance=1)
+    return out
 
 
 # --------------------------------------------------------------------------- the store
@@ -396,4 +441,4 @@ def write_tables(records, jobs: list[Job], columns: list[str], sources: list[str
     return files
 
 
-__all__ = ["Job", "BatchOutcome", "fit_task", "make_jobs", "run_batch", "write_tables", "mean_ranks"]
+__all__ = ["Job", "BatchOutcome", "fit_task", "fit_batch", "make_jobs", "run_batch", "write_tables", "mean_ranks"]

@@ -126,7 +126,7 @@ def register(app: typer.Typer) -> None:
     ) -> None:
         """Fit an analytic model to a measured material (MERL file or built-in); or a whole batch."""
         from .. import registry
-        from .fit import METRICS
+        from .metrics import METRICS
 
         if metric not in METRICS:
             raise ValueError(f"unknown metric {metric!r}; valid metrics: {', '.join(METRICS)}")
@@ -153,7 +153,8 @@ def register(app: typer.Typer) -> None:
 
 
 def _single(source, model_name, param, metric, starts, samples, seed, as_json, report, lobes=1) -> None:
-    from .fit import fit, resolve_source
+    from .optimise import fit
+    from .samples import resolve_source
 
     fixed = _fixed_for(model_name, param, strict=True)
     if report:

@@ -52,7 +52,7 @@ def shade_sphere(model, size: int = 160) -> np.ndarray:
 
 
 def write_report(result, measured, out_dir: str) -> dict[str, Any]:
-    """Write the report of a :class:`~brdfkit.measured.fit.FitResult`; returns the file paths."""
+    """Write the report of a :class:`~brdfkit.measured.result.FitResult`; returns the file paths."""
     import matplotlib
 
     matplotlib.use("Agg")

@@ -172,7 +172,7 @@ class AshikhminShirley(BRDF):
         Param("rd", "rgb", 0.5, (0.0, 1.0), "", "diffuse reflectance R_d"),
         Param("rs", "rgb", 0.05, (0.0, 1.0), "", "specular reflectance at normal incidence R_s (Schlick F0)"),
         exponent_param("nu", 100.0, "Phong exponent along the tangent +x (smaller = wider highlight in x)"),
-        exponent_param("nv", 100.0, "Phong exponent along the bitangent +y"),
+        exponent_param("nv", 100.0, "Phong exponent along the bitangent +y", tie="nu"),
         Param("kd", "rgb", 0.5, (0.0, 1.0), "", "Lambert diffuse albedo kd (variant=ngan only)"),
         Param("ks", "rgb", 1.0, (0.0, 10.0), "", "weight of the specular lobe (variant=ngan only)",
               fit_range=(0.0, 5.0)),

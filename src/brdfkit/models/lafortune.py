@@ -139,7 +139,7 @@ def _lobe_params(k: int, ks_default: float) -> tuple[Param, ...]:
         Param(f"ks_{k}", "rgb", ks_default, (0.0, 1e6), "", f"weight ρ_s of lobe {k}",
               fit_range=(1e-6, 1e6), log_scale=True),
         Param(f"cx_{k}", "scalar", -1.0, (-100.0, 100.0), "", f"C_x of lobe {k} (tangent)"),
-        Param(f"cy_{k}", "scalar", -1.0, (-100.0, 100.0), "", f"C_y of lobe {k} (bitangent)"),
+        Param(f"cy_{k}", "scalar", -1.0, (-100.0, 100.0), "", f"C_y of lobe {k} (bitangent)", tie=f"cx_{k}"),
         Param(f"cz_{k}", "scalar", 1.0, (-100.0, 100.0), "", f"C_z of lobe {k} (normal; held fixed in fits)",
               fit=False),
         Param(f"n_{k}", "scalar", 20.0, (0.0, 1e5), "", f"exponent of lobe {k}", fit_range=(1.0, 1e5),

@@ -99,7 +99,7 @@ _ALPHA = Param(
 _ALPHA_X = Param("alpha_x", "scalar", ALPHA_DEFAULT, ALPHA_RANGE, "",
                  "roughness along the tangent +x (anisotropic use)", log_scale=True)
 _ALPHA_Y = Param("alpha_y", "scalar", ALPHA_DEFAULT, ALPHA_RANGE, "",
-                 "roughness along the bitangent +y (anisotropic use)", log_scale=True)
+                 "roughness along the bitangent +y (anisotropic use)", log_scale=True, tie="alpha_x")
 
 # cosines are floored in the 1/(4 cos cos) factor so that it stays finite (kernels compute in float64)
 COS_FLOOR = 1e-150

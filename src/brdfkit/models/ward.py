@@ -181,6 +181,7 @@ class Ward(BRDF):
             "",
             "RMS surface slope along the bitangent +y",
             log_scale=True,
+            tie="alpha_x",
         ),
         Param(
             "normalization",

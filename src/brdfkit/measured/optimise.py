@@ -1,0 +1,346 @@
+"""The optimiser of a fit: multi-start bounded least squares, and :func:`fit`, which runs it.
+
+``fit(name, measured, fixed={...}, metric="ngan")`` finds the parameters of the registered
+model ``name`` that best reproduce ``measured`` (a MERL file, a built-in material name, or
+any isotropic model): its free values (:mod:`brdfkit.measured.packing`) minimise the metric
+(:mod:`brdfkit.measured.metrics`) over weighted measured samples
+(:mod:`brdfkit.measured.samples`).
+
+Optimiser: ``scipy.optimize.least_squares`` (trust-region reflective, bounds) from several
+starts: the parameters' defaults plus the best of a few dozen random points of the bounded
+parameter space (multi-start, so a local minimum does not decide); the best result wins. A
+start that enters the basin of a minimum an earlier start converged to (within
+:data:`JOIN_XTOL` of it in every free value, :data:`JOIN_RTOL` in cost) stops there; its
+``start_errors`` entry is the error it had then. The Jacobian is by forward differences,
+cheaper where the model allows (:mod:`brdfkit.measured.jacobian`). A ``samples="table"``
+fit searches on :data:`TABLE_SEARCH_SAMPLES` of the bins and polishes the best start on all
+of them (:func:`_polish`).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from contextlib import contextmanager
+from dataclasses import dataclass
+from typing import Any, Callable, Mapping
+
+import numpy as np
+
+from ..models.base import BRDF
+from .jacobian import channel_groups, constant_columns, jacobian, probe_columns
+from .lobes import two_lobe
+from .metrics import METRICS, error, transform
+from .packing import ParamPacker
+from .progress import fit_progress
+from .residuals import freeze_unused, residual_fn
+from .result import FitResult, flush_subnormal, slots_at_bound
+from .samples import Samples, sample, subsample, table
+
+#: a start that reaches a point within this fraction of every free value's (optimiser-space) range
+#: of a minimum an earlier start converged to, with a cost within :data:`JOIN_RTOL` of that
+#: minimum's, is in the same basin: it stops there instead of converging again (the basin-joining
+#: rule of clustering multi-start methods, Rinnooy Kan & Timmer, Math. Programming 39, 1987)
+JOIN_XTOL = 1e-2
+JOIN_RTOL = 1e-3
+
+
+class _Joined(Exception):
+    """Raised inside a start's residuals when it has entered a known minimum's basin."""
+
+    def __init__(self, x: np.ndarray, cost: float) -> None:
+        super().__init__()
+        self.x, self.cost = x, cost
+
+
+class _Start:
+    """One local optimisation's residuals: counts evaluations, remembers the last one (the
+    Jacobian is taken where the residuals were just evaluated) and stops in a known basin."""
+
+    def __init__(self, residuals, packer: ParamPacker, known: list[tuple[np.ndarray, float]]) -> None:
+        self.residuals, self.known, self.nfev = residuals, known, 0
+        self.span = np.maximum(packer.ub - packer.lb, 1e-300)
+        self._last: tuple[np.ndarray, np.ndarray] | None = None
+
+    def __call__(self, x: np.ndarray) -> np.ndarray:
+        r = self.evaluate(x)
+        self.check(x, r)
+        return r
+
+    def evaluate(self, x: np.ndarray) -> np.ndarray:
+        """The residuals at ``x``, counted and remembered, without the basin test."""
+        r = self.residuals(x)
+        self.nfev += 1
+        self._last = (np.array(x, dtype=np.float64), r)
+        return r
+
+    def check(self, x: np.ndarray, r: np.ndarray | Callable[[], np.ndarray]) -> None:
+        """Raise :class:`_Joined` if ``x`` with residuals ``r`` (or ``r()``, called only if needed)
+        lies in a known minimum's basin."""
+        c = None
+        for xk, ck in self.known:
+            if float(np.max(np.abs(x - xk) / self.span)) <= JOIN_XTOL:
+                if c is None:
+                    rv = r() if callable(r) else r
+                    c = float(rv @ rv)
+                if c <= ck * (1 + JOIN_RTOL):
+                    raise _Joined(np.array(x, dtype=np.float64), c)
+
+    def at(self, x: np.ndarray) -> np.ndarray:
+        """The residuals at ``x``, reusing the last evaluation if it was there."""
+        if self._last is not None and np.array_equal(self._last[0], x):
+            return self._last[1]
+        return self(x)
+
+
+def _local(residuals, x0, packer, max_nfev, tol, known=(), const=None, groups=None):
+    """A bounded least-squares run from ``x0``: ``(x, cost = Σ r², evaluations, joined)``.
+
+    ``known``: ``(x, cost)`` of minima found by earlier starts; a run that enters one's
+    basin (:data:`JOIN_XTOL`, :data:`JOIN_RTOL`) stops there. ``const``: the
+    :func:`constant_columns` of the Jacobian; ``groups``: its :func:`channel_groups`."""
+    from scipy.optimize import least_squares
+
+    x0 = np.clip(x0, packer.lb, packer.ub)
+    # least_squares needs x0 strictly inside the bounds
+    eps = 1e-9 * np.maximum(1.0, packer.ub - packer.lb)
+    x0 = np.minimum(np.maximum(x0, packer.lb + eps), packer.ub - eps)
+    # a model evaluated in float32 (a .brdf file's GLSL) declares a finite-difference step its
+    # values can resolve; scipy's default (~1e-8 relative) would see no change at all
+    diff_step = getattr(packer.cls, "fit_diff_step", None)
+    fn = _Start(residuals, packer, list(known))
+    grouped = groups is not None and any(len(g) > 1 for g in groups)
+    jac = jacobian(fn, packer, const or {}, groups if grouped else None) if const or grouped else "2-point"
+    try:
+        res = least_squares(
+            fn, x0, jac=jac, bounds=(packer.lb, packer.ub), method="trf", x_scale="jac", tr_solver="lsmr",
+            max_nfev=max_nfev, xtol=tol, ftol=tol, gtol=tol, diff_step=diff_step,
+        )
+    except _Joined as j:
+        return j.x, j.cost, fn.nfev, True
+    return res.x, float(2 * res.cost), fn.nfev, False
+
+
+#: a residual vector of at most this many samples is evaluated on one thread: the engine's
+#: parallel driver splits a call into chunks of 2048 pairs, and at a few thousand pairs a second
+#: thread per call saves nothing (3000 GGX pairs: 0.196 ms per call on two threads, 0.181 ms on
+#: one, measured on the shared 2-core machine) and a batch already runs one fit per core
+SERIAL_SAMPLES = 65536
+
+
+@contextmanager
+def _engine_threads(n_samples: int):
+    """Evaluate on one numba thread while fitting ``n_samples`` samples, if that is few."""
+    import numba
+
+    if n_samples > SERIAL_SAMPLES:
+        yield
+        return
+    before = numba.get_num_threads()
+    numba.set_num_threads(1)
+    try:
+        yield
+    finally:
+        numba.set_num_threads(before)
+
+
+#: Levenberg-Marquardt iterations of the table-scale polish
+POLISH_ITERATIONS = 4
+
+
+def _polish(residuals, x, packer: ParamPacker, iterations: int = POLISH_ITERATIONS) -> tuple[np.ndarray, int]:
+    """A few bounded Levenberg-Marquardt steps on a large residual vector (every table bin).
+
+    ``least_squares`` would hold the whole (residuals × parameters) Jacobian and run LSMR
+    on it (2.7 M × 10 for a table: seconds per iteration); here the forward-difference
+    columns are reduced at once to the normal equations JᵀJ (n × n) and Jᵀr, and a step is
+    kept only if it lowers the cost, so the result is never worse than the start.
+    Returns ``(x, evaluations)``."""
+    n = len(x)
+    r = residuals(x)
+    cost = float(r @ r)
+    used, lam = 1, 1e-3
+    for _ in range(iterations):
+        J = np.empty((n, r.size), np.float32)  # forward-difference columns, as rows
+        for i in range(n):
+            h = 1e-6 * max(1.0, abs(float(x[i])))
+            if x[i] + h > packer.ub[i]:
+                h = -h
+            y = x.copy()
+            y[i] += h
+            J[i] = (residuals(y) - r) / h
+            used += 1
+        JtJ = (J @ J.T).astype(np.float64)
+        Jtr = (J @ r.astype(np.float32)).astype(np.float64)
+        del J
+        improved = False
+        for _try in range(6):
+            A = JtJ + lam * np.diag(np.maximum(np.diag(JtJ), 1e-30))
+            try:
+                step = -np.linalg.solve(A, Jtr)
+            except np.linalg.LinAlgError:
+                lam *= 10
+                continue
+            y = np.clip(x + step, packer.lb, packer.ub)
+            ry = residuals(y)
+            used += 1
+            cy = float(ry @ ry)
+            if cy < cost:
+                x, r, cost, lam, improved = y, ry, cy, max(lam / 10, 1e-9), True
+                break
+            lam *= 10
+        if not improved:
+            break
+    return x, used
+
+
+#: samples of the multi-start search of a ``samples="table"`` fit (the polish runs on every bin)
+TABLE_SEARCH_SAMPLES = 3000
+
+
+def fit(
+    name: str | type[BRDF],
+    measured: Any,
+    fixed: Mapping[str, Any] | None = None,
+    metric: str = "ngan",
+    *,
+    starts: int = 4,
+    candidates: int = 48,
+    samples: int | str = 3000,
+    lobes: int = 1,
+    seed: int = 0,
+    max_theta_deg: float = 80.0,
+    max_nfev: int | None = None,
+    tol: float = 1e-8,
+    progress: bool | Callable[[int, int], None] = False,
+    data: Samples | None = None,
+) -> FitResult:
+    """Fit the registered analytic model ``name`` (or a :class:`BRDF` subclass) to ``measured``.
+
+    ``measured``: a MERL file path, a built-in material name (``"merl/chrome"``) or a
+    model (e.g. :func:`brdfkit.load_merl`'s). ``fixed``: parameters held at the given
+    values. ``metric``: one of :data:`METRICS`. ``samples``: the number of weighted
+    samples (:func:`sample`), or ``"table"``: every measured bin (:func:`table`); then the
+    multi-start search runs on :data:`TABLE_SEARCH_SAMPLES` of them and the best start is
+    polished on all. ``lobes``: 1, or 2 for a second specular lobe (:func:`two_lobe`;
+    Lafortune: its own ``lobes``). ``starts``: local optimisations run (from the defaults
+    and the best of ``candidates`` random points). ``data``: precomputed :func:`sample` or
+    :func:`table` output (then ``measured`` only names the source).
+    Returns a :class:`FitResult` (``params`` holds every parameter of the model;
+    ``at_bound`` lists the free values that ended on a fitting bound).
+    """
+    t0 = time.perf_counter()
+    is_table = _check_options(metric, starts, samples, lobes)
+    cls, fixed = _model_class(name, lobes, fixed)
+    packer = ParamPacker(cls, fixed)
+    if data is None:
+        data = table(measured, max_theta_deg) if is_table else sample(measured, n=samples, seed=seed,
+                                                                      max_theta_deg=max_theta_deg)
+    search = subsample(data, TABLE_SEARCH_SAMPLES, seed) if is_table else data
+    T = transform(metric)
+    residuals = residual_fn(packer, search, T, metric)
+    if len(packer) == 0:  # nothing free: just evaluate
+        model = packer.model(np.zeros(0))
+        err = error(model, data, metric)
+        return FitResult(model, dict(model.params), err, metric, data.source, len(data), 0, 1,
+                         time.perf_counter() - t0, sorted(packer.fixed_names), [], [err], lobes=lobes,
+                         search_samples=len(search))
+    # from here on the model is built from the free values
+    plan = _plan_starts(packer, residuals, len(search), seed, candidates, starts)
+    nfev = plan.evaluations
+    total = len(plan.chosen) + (1 if search is not data else 0)
+    best_x, best_cost = None, math.inf
+    start_errors = []
+    known: list[tuple[np.ndarray, float]] = []  # the minima the starts converged to
+    with fit_progress(progress, f"fit {cls.name} ← {data.source}", total) as step:
+        for n_done, x0 in enumerate(plan.chosen, 1):
+            with _engine_threads(len(search)):
+                x, cst, used, joined = _local(residuals, x0, packer, max_nfev or 100, tol, known, plan.const,
+                                              plan.groups)
+            nfev += used
+            start_errors.append(math.sqrt(cst))
+            if not joined:
+                known.append((x, cst))
+            if cst < best_cost:
+                best_cost, best_x = cst, x
+            step(n_done)
+        if search is not data:  # polish the best start on every bin
+            best_x, used = _polish(residual_fn(packer, data, T, metric), best_x, packer)
+            nfev += used
+            step(total)
+    # the model of the reported parameters: a subnormal value (kd pressed to 0) as 0 (brdfkit.measured.result)
+    model = packer.cls(**flush_subnormal(packer.params(best_x)))
+    err = error(model, data, metric)
+    return FitResult(
+        model, dict(model.params), err, metric, data.source, len(data), len(plan.chosen), nfev,
+        time.perf_counter() - t0, sorted(packer.fixed_names), list(packer.frozen), start_errors,
+        len(packer), slots_at_bound(packer, best_x), lobes, len(search),
+    )
+
+
+def _check_options(metric: str, starts: int, samples: int | str, lobes: int) -> bool:
+    """One-line ``ValueError`` for a bad option of :func:`fit`; whether ``samples`` is ``"table"``."""
+    if metric not in METRICS:
+        raise ValueError(f"unknown metric {metric!r}; valid metrics: {', '.join(METRICS)}")
+    if starts < 1:
+        raise ValueError(f"starts must be at least 1, got {starts}")
+    is_table = isinstance(samples, str)
+    if is_table and samples != "table":
+        raise ValueError(f"samples must be a number of samples or 'table', got {samples!r}")
+    if not is_table and (isinstance(samples, bool) or not isinstance(samples, (int, np.integer))):
+        raise ValueError(f"samples must be a number of samples or 'table', got {samples!r}")
+    if isinstance(lobes, bool) or lobes not in (1, 2):
+        raise ValueError(f"lobes must be 1 or 2, got {lobes!r}")
+    return is_table
+
+
+def _model_class(name: str | type[BRDF], lobes: int, fixed: Mapping[str, Any] | None
+                 ) -> tuple[type[BRDF], dict[str, Any]]:
+    """The class :func:`fit` fits and its fixed values: with ``lobes=2`` a model's own ``lobes``
+    parameter set to 2 (Lafortune), else the :func:`~brdfkit.measured.lobes.two_lobe` class."""
+    from .. import registry
+
+    cls = name if isinstance(name, type) and issubclass(name, BRDF) else registry.get(name)
+    fixed = dict(fixed or {})
+    if lobes == 2:
+        if any(p.name == "lobes" for p in cls.spec):
+            fixed.setdefault("lobes", 2)
+        else:
+            cls = two_lobe(cls)
+    return cls, fixed
+
+
+@dataclass
+class _StartPlan:
+    """Where the local runs of a fit start, and what they know of the Jacobian beforehand."""
+
+    chosen: list[np.ndarray]  # the starting points, the defaults first
+    const: dict[int, np.ndarray]  # constant_columns
+    groups: list[list[int]] | None  # channel_groups
+    evaluations: int  # residual evaluations spent choosing (counted as before: an upper bound)
+
+
+def _plan_starts(packer: ParamPacker, residuals, n_samples: int, seed: int, candidates: int, starts: int
+                 ) -> _StartPlan:
+    """Freeze the unused slots, then take the defaults and the best ``starts - 1`` of ``candidates``
+    random points (by cost), and probe the Jacobian's columns at the first two of them."""
+    rng = np.random.default_rng(seed + 1)
+    nfev = 2 * (len(packer) + 1)  # freeze_unused: at most 2 points × (base + one probe per slot)
+    with _engine_threads(n_samples):
+        freeze_unused(packer, residuals, rng)
+        cand = [packer.x_of(packer.fixed)]
+        if candidates > 0:
+            cand += list(packer.random_x(rng, candidates))
+        costs = np.array([float(r @ r) for r in map(residuals, cand)])
+        # Jacobian columns known once for all (a float32-evaluated model's differences are too noisy)
+        const, groups = {}, None
+        if not getattr(packer.cls, "fit_diff_step", None):
+            probes = probe_columns(residuals, packer, cand[:2])
+            nfev += probes.evaluations
+            const = constant_columns(residuals, packer, cand[:2], probes)
+            groups = channel_groups(residuals, packer, cand[:2], const, probes)
+    nfev += len(cand)
+    order = [0] + [int(i) for i in np.argsort(costs) if i != 0]
+    return _StartPlan([cand[i] for i in order[:starts]], const, groups, nfev)
+
+__all__ = ["fit", "JOIN_XTOL", "JOIN_RTOL", "TABLE_SEARCH_SAMPLES", "SERIAL_SAMPLES", "POLISH_ITERATIONS"]

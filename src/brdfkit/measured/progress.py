@@ -1,0 +1,54 @@
+"""The progress of one fit: a transient bar of its starts on a terminal, and/or a callback.
+
+The bar is drawn on standard error, and only when that is a terminal: the fit's own output
+(``brdfkit fit``'s text or JSON on standard output) stays exactly what it prints (rich's live
+display, stopped on a console that is not a terminal, would leave an empty line there).
+"""
+
+from __future__ import annotations
+
+from contextlib import contextmanager
+from typing import Callable, Iterator
+
+
+def _bar(title: str, total: int):
+    """A started rich progress bar of ``total`` starts on a terminal's standard error, and its
+    task; ``None`` when standard error is not a terminal."""
+    from rich.console import Console
+    from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
+
+    console = Console(stderr=True)
+    if not console.is_terminal:
+        return None
+    bar = Progress(
+        TextColumn(title), BarColumn(), TextColumn("{task.completed}/{task.total} starts"),
+        TimeElapsedColumn(), console=console, transient=True,
+    )
+    bar.start()
+    return bar, bar.add_task("fit", total=total)
+
+
+@contextmanager
+def fit_progress(progress: bool | Callable[[int, int], None], title: str, total: int
+                 ) -> Iterator[Callable[[int], None]]:
+    """``step(done)``, to call as each of ``total`` steps (local starts, a polish) ends.
+
+    ``progress``: ``True`` for the bar (titled ``title``), a callable ``(done, total)`` called at
+    every step, or ``False`` for neither. The bar is taken down on leaving, also on an error."""
+    callback = progress if callable(progress) else None
+    shown = _bar(title, total) if progress is True else None
+
+    def step(done: int) -> None:
+        if shown is not None:
+            shown[0].update(shown[1], advance=1)
+        if callback is not None:
+            callback(done, total)
+
+    try:
+        yield step
+    finally:
+        if shown is not None:
+            shown[0].stop()
+
+
+__all__ = ["fit_progress"]
