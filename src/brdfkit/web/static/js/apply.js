@@ -1,6 +1,5 @@
 // Applying a state (the URL, a saved view file, window.brdfkit.setState): every bad part is
 // shown on the page as an error, never dropped silently; the rest is still applied.
-"use strict";
 
 import * as store from "./store.js";
 import { showError } from "./dom.js";

@@ -2,7 +2,6 @@
 // .brdf files), their GLSL programs, and evaluation on the GPU: brdf() for direction pairs
 // read from float textures into an RGBA32F target and read back (every plot, the albedo
 // quadrature, window.brdfkit.eval).
-"use strict";
 
 import * as store from "./store.js";
 import { gl, compileProgram, U, makeFloatTexture } from "./gl.js";

@@ -1,5 +1,4 @@
 // DOM helpers and the page's error list (bad URL values, bad files, failed uploads: never silent).
-"use strict";
 
 export const $ = (sel, root) => (root || document).querySelector(sel);
 export const $$ = (sel, root) => Array.from((root || document).querySelectorAll(sel));

@@ -2,7 +2,6 @@
 // from the server) and an .obj mesh. Their bytes survive a reload: they are kept in IndexedDB
 // under their SHA-256, the state (URL, saved view) names them ({name, sha256}); a state naming
 // a file this browser no longer holds is an error on the page.
-"use strict";
 
 import * as store from "./store.js";
 import { $, showError } from "./dom.js";

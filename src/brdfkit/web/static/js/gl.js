@@ -1,6 +1,5 @@
 // The page's one WebGL 2 context. Its canvas is off-screen: each view is a 2D canvas the GL
 // image is copied into (blit). `gl` and `glCanvas` are live bindings, set once by initGL().
-"use strict";
 
 export let gl = null;
 export let glCanvas = null;

@@ -1,7 +1,6 @@
 // The views and the two panes that show them (tabs; a view lives in one pane at a time), the
 // draw loop (a change redraws the panes on the next animation frame, or only the view it
 // affects), and the PNG / CSV exports.
-"use strict";
 
 import * as store from "./store.js";
 import { $, $$, canvasOf, download, el, showError } from "./dom.js";

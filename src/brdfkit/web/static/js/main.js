@@ -12,7 +12,6 @@
 // ./apply.js carry the state in the URL. This module starts the page and defines its API for
 // scripts and tests (SPEC.md: window.brdfkit.eval, views, state); window.brdfkitStatus reports
 // readiness and per-model compile errors.
-"use strict";
 
 import * as store from "./store.js";
 import { $, canvasOf, clearErrors, download, el, errors, setStatus, showError } from "./dom.js";

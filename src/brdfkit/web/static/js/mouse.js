@@ -1,5 +1,4 @@
 // The mouse: drag the light on the lit sphere; orbit (drag) and zoom (wheel) the 3D lobe and the lit object.
-"use strict";
 
 import * as store from "./store.js";
 import { canvasOf } from "./dom.js";

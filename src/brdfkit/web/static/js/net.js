@@ -1,6 +1,5 @@
 // Requests to the page's own server (nothing is fetched from outside): an answer's
 // {"error"} becomes an Error with that one line.
-"use strict";
 
 export async function fetchText(url) {
   const r = await fetch(url);

@@ -3,7 +3,6 @@
 // (many inputs, 1e-6 relative): srgbEncode / srgbToLinear (brdfkit.render.image),
 // fromHalfDiff (brdfkit.geometry.from_rusinkiewicz), effectiveParams (the alpha rule of
 // the microfacet-style models' parameters), eyeToMap (brdfkit.render.ibl.eye_to_map).
-"use strict";
 
 export const DEG = Math.PI / 180;
 export const STEPS = 1000;          // slider positions

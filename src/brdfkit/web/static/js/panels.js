@@ -1,6 +1,5 @@
 // The BRDF panels: one per BRDF shown, each with its model, its parameter controls and its
 // colour. The list lives in the store ("panels"); a panel reports a change with store.changed().
-"use strict";
 
 import * as store from "./store.js";
 import { $, el, showError } from "./dom.js";

@@ -1,6 +1,5 @@
 // The view settings: the global bar's and each view's controls in index.html, read and set by id.
 // The controls themselves hold the values (their defaults are the store's `defaults`).
-"use strict";
 
 import * as store from "./store.js";
 import { $, $$ } from "./dom.js";

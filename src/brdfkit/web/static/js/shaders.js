@@ -1,6 +1,5 @@
 // GLSL sources the page adds to a BRDF's own (which defines vec3 brdf(vec3 wi, vec3 wo)):
 // the mains of the per-pixel views, and the renderer's pipeline assembled from render/shaders.
-"use strict";
 
 export const VERT = `#version 300 es
 void main() {

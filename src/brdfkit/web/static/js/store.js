@@ -21,7 +21,6 @@
 //
 // Events (subscribe(name, fn) like a key): "changed" (only: a view name or null) after any change
 // of state, "draw" (only) to redraw without a state change, "catalog" when the list of BRDFs changes.
-"use strict";
 
 const values = new Map();
 const listeners = new Map();

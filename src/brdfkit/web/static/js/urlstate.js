@@ -1,7 +1,6 @@
 // The page's state as a JSON-able object (window.brdfkit.state(), the saved view) and as the URL:
 // ?model=NAME&p=JSON&compare=JSON&view=JSON[&hide=1][&files=JSON] (SPEC.md, "The explorer page").
 // Reading a URL throws a one-line Error naming the bad part; ./apply.js shows it on the page.
-"use strict";
 
 import * as store from "./store.js";
 import { allSettings } from "./settings.js";

@@ -1,5 +1,4 @@
 // The directional albedo ρ(θi): GPU quadrature of the model's GLSL, or the engine on the server.
-"use strict";
 
 import * as store from "../store.js";
 import { $, canvasOf, showError } from "../dom.js";

@@ -1,6 +1,5 @@
 // The cartesian curves: f_r against θv in the plane of incidence, and against θh or θd
 // (Rusinkiewicz's half/difference angles) at the other angles of the bar.
-"use strict";
 
 import { canvasOf } from "../dom.js";
 import { DEG, fmt, fromHalfDiff } from "../numbers.js";

@@ -1,6 +1,5 @@
 // The lit object under an environment map: the renderer's ibl.glsl, progressive (one pass of
 // IBL_SPP samples per pixel per frame, accumulated here until obj-ibl-spp).
-"use strict";
 
 import * as store from "../store.js";
 import { showError } from "../dom.js";

@@ -1,5 +1,4 @@
 // The 3D lobe: f_r over the hemisphere of wo as a wire surface, orbited with the mouse.
-"use strict";
 
 import * as store from "../store.js";
 import { canvasOf } from "../dom.js";

@@ -1,6 +1,5 @@
 // The lit object's meshes: built-ins from /api/mesh (cached per tessellation), or the uploaded OBJ
 // (the store's "uploadedMesh"), as GL buffers.
-"use strict";
 
 import * as store from "../store.js";
 import { showError } from "../dom.js";

@@ -1,6 +1,5 @@
 // The lit object: a mesh drawn by the renderer's own pipeline GLSL (a BRDF under one light, or
 // the OpenGL fixed-function model), or lit by an environment (./ibl.js).
-"use strict";
 
 import * as store from "../store.js";
 import { $, canvasOf, el } from "../dom.js";

@@ -1,6 +1,5 @@
 // What the plot views share: frames, axes and legends on a 2D canvas, the curves of the visible
 // BRDFs (evaluated on the GPU), the CSV table of a plot, the tiles of the per-pixel views.
-"use strict";
 
 import * as store from "../store.js";
 import { showError } from "../dom.js";

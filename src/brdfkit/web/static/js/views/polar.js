@@ -1,5 +1,4 @@
 // The polar plot: f_r (· cos θi) in the plane of incidence, the light at θi, the mirror direction dashed.
-"use strict";
 
 import { canvasOf } from "../dom.js";
 import { DEG, fmt } from "../numbers.js";

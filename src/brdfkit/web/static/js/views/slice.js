@@ -1,5 +1,4 @@
 // The image slice: θh × θd at φd (Rusinkiewicz 1998), one tile per visible BRDF, by SLICE_MAIN.
-"use strict";
 
 import { canvasOf } from "../dom.js";
 import { gl, glCanvas, glSize, U } from "../gl.js";

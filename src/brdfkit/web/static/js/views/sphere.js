@@ -1,5 +1,4 @@
 // The lit sphere: one tile per visible BRDF, ray-cast per pixel by SPHERE_MAIN, a directional light.
-"use strict";
 
 import { canvasOf } from "../dom.js";
 import { gl, glCanvas, glSize, U } from "../gl.js";
