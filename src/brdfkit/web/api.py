@@ -29,7 +29,7 @@ Endpoints (all local; nothing here reaches outside the machine):
 ``POST /api/mesh`` (body: an OBJ file)
     the same for an uploaded OBJ, read by :func:`brdfkit.render.meshes.load_mesh`.
 ``POST /api/merl`` (body: a MERL ``.binary`` file)
-    read with ``bk.load_merl``; answers ``application/octet-stream``: the table as the
+    read with :func:`brdfkit.measured.merl.load_merl`; answers ``application/octet-stream``: the table as the
     float32 RGBA texels of ``measured.glsl``'s ``u_table`` (90×90×180×4,
     :func:`brdfkit.render.glsl.table_texels`).
 ``POST /api/brdf?name=FILE.brdf`` (body: a Disney BRDF Explorer ``.brdf`` file)
