@@ -301,7 +301,7 @@ def test_a_full_pool_answers_503_instead_of_piling_up(monkeypatch):
 from hypothesis import HealthCheck, given, settings, strategies as st  # noqa: E402
 
 _TARGET_PARTS = st.sampled_from(
-    ["/", "/api/", "/api/eval", "/api/models", "/api/shader/", "/static/", "index.html", "app.js", "..", "%00", "%2e%2e",
+    ["/", "/api/", "/api/eval", "/api/models", "/api/shader/", "/static/", "index.html", "app.js", "js/", "views/", "main.js", "..", "%00", "%2e%2e",
      "%2f", "%ff", "?", "&", "=", "model=ward", "params=", "%7B%22kd%22:", "[[", "]]", "1e400", "wi=0,0,1", "wo=",
      "\\", "//", "%0a", "#", ";", "~", "\x7f", "\xe9"]
 )

@@ -12,6 +12,7 @@ import subprocess
 import sys
 import urllib.error
 import urllib.request
+from pathlib import Path
 from urllib.parse import quote, urlencode
 
 import numpy as np
@@ -19,7 +20,7 @@ import pytest
 
 import brdfkit as bk
 from brdfkit.render import glsl
-from brdfkit.web import make_server, start_in_thread
+from brdfkit.web import STATIC_DIR, make_server, start_in_thread
 
 
 @pytest.fixture(scope="module")
@@ -205,18 +206,76 @@ def test_unknown_paths_404(server):
         assert "error" in json.loads(body)
 
 
+def _module_graph(server, entry: str) -> dict[str, str]:
+    """Every ES module the page loads, from ``entry`` along its static imports: URL path -> text."""
+    import posixpath
+    import re
+
+    seen: dict[str, str] = {}
+    todo = [entry]
+    while todo:
+        path = todo.pop()
+        if path in seen:
+            continue
+        status, ctype, body = get(server, path)
+        assert status == 200, path
+        assert ctype.split(";")[0].strip() == "text/javascript", (path, ctype)  # a module needs a JavaScript type
+        seen[path] = text = body.decode("utf-8")
+        for spec in re.findall(r'^\s*import\b[^;]*?from\s+"([^"]+)"', text, re.M):
+            assert spec.startswith("./") or spec.startswith("../"), (path, spec)  # relative: nothing from outside
+            todo.append(posixpath.normpath(posixpath.join(posixpath.dirname(path), spec)))
+    return seen
+
+
 def test_static_page_is_self_contained(server):
     status, ctype, html = get(server, "/")
     assert status == 200 and ctype.startswith("text/html")
     html = html.decode()
-    for asset in ("/static/app.js", "/static/style.css"):
+    assert '<script type="module" src="/static/js/main.js"></script>' in html
+    for asset in ("/static/js/main.js", "/static/style.css"):
         assert asset in html
         s, c, body = get(server, asset)
         assert s == 200 and len(body) > 100, asset
-    _, _, js = get(server, "/static/app.js")
-    # nothing fetched from outside: no absolute URLs in the page or the script
-    for text in (html, js.decode(), get(server, "/static/style.css")[2].decode()):
+    modules = _module_graph(server, "/static/js/main.js")
+    served = {"/static/js/" + p.relative_to(STATIC_DIR / "js").as_posix() for p in (STATIC_DIR / "js").rglob("*.js")}
+    assert set(modules) == served  # every module file is used, every import is served
+    assert get(server, "/static/app.js")[0] == 404  # the one-closure script is gone
+    # nothing fetched from outside: no absolute URLs in the page, its modules or the style sheet
+    for text in [html, get(server, "/static/style.css")[2].decode(), *modules.values()]:
         assert "http://" not in text and "https://" not in text and "//cdn" not in text
+
+
+def test_static_modules_are_small(server):
+    """No module of the page is over ~600 lines (the page was one 2182-line closure)."""
+    for p in (STATIC_DIR / "js").rglob("*.js"):
+        n = p.read_text(encoding="utf-8").count("\n")
+        assert n <= 600, f"{p.name}: {n} lines"
+
+
+def test_static_types_and_no_way_out(server):
+    assert get(server, "/static/style.css")[1].startswith("text/css")
+    assert get(server, "/static/js/views/sphere.js")[1].startswith("text/javascript")
+    for path in ("/static/js/../../server.py", "/static/js/%2e%2e/%2e%2e/server.py", "/static/js//main.js",
+                 "/static/js/..%2fstore.js", "/static/js\\main.js", "/js/../../api.py"):
+        status, _, body = get(server, path)
+        assert status == 404 and "error" in json.loads(body), path
+
+
+def test_wheel_data_lists_every_static_folder():
+    """package-data ships every folder of the page (a wheel or sdist install must serve it)."""
+    import fnmatch
+
+    try:
+        import tomllib
+    except ImportError:  # pragma: no cover - Python < 3.11
+        pytest.skip("tomllib needs Python 3.11")
+    root = Path(__file__).resolve().parents[1]
+    patterns = tomllib.loads((root / "pyproject.toml").read_text())["tool"]["setuptools"]["package-data"]["brdfkit"]
+    pkg = root / "src" / "brdfkit"
+    for p in STATIC_DIR.rglob("*"):
+        if p.is_file():
+            rel = p.relative_to(pkg).as_posix()
+            assert any(fnmatch.fnmatch(rel, pat) and rel.count("/") == pat.count("/") for pat in patterns), rel
 
 
 def test_make_server_rejects_bad_port_and_host():

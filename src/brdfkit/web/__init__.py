@@ -1,7 +1,7 @@
 """The browser explorer served by ``brdfkit serve``.
 
 A standard-library HTTP server (:mod:`brdfkit.web.server`) serves a static
-single-page app (``static/``: plain JavaScript and WebGL 2, no build step,
+single-page app (``static/``: native ES modules and WebGL 2, no build step,
 nothing fetched from outside) and a small JSON API. The page builds its
 controls from each model's parameter spec, compiles the model's GLSL twin
 (``render/shaders``) in the browser and shows a lit sphere and an in-plane

@@ -29,7 +29,7 @@ Endpoints (all local; nothing here reaches outside the machine):
 ``POST /api/mesh`` (body: an OBJ file)
     the same for an uploaded OBJ, read by :func:`brdfkit.render.meshes.load_mesh`.
 ``POST /api/merl`` (body: a MERL ``.binary`` file)
-    read with ``bk.load_merl``; answers ``application/octet-stream``: the table as the
+    read with :func:`brdfkit.measured.merl.load_merl`; answers ``application/octet-stream``: the table as the
     float32 RGBA texels of ``measured.glsl``'s ``u_table`` (90×90×180×4,
     :func:`brdfkit.render.glsl.table_texels`).
 ``POST /api/brdf?name=FILE.brdf`` (body: a Disney BRDF Explorer ``.brdf`` file)
@@ -58,6 +58,9 @@ from typing import Callable
 
 import numpy as np
 
+from .. import registry
+from .jsonio import jsonable, loads
+
 Handler = Callable[[dict, bytes], tuple[int, str, bytes]]
 
 ROUTES: dict[tuple[str, str], Handler] = {}
@@ -74,17 +77,13 @@ def _refuse(name) -> None:
         raise ValueError("model: must be a name")
     if name.endswith((".brdf", ".binary")) or name.count("/") > 1 or name.startswith((".", "/", "~")):
         raise ValueError("model: a name is expected; file paths are not accepted over HTTP (drop the file on the page)")
-    import brdfkit as bk
-
     shown = name if len(name) <= 80 and name.isprintable() else repr(name[:80]) + "..."
-    raise ValueError(f"unknown model {shown!r}; valid models: {', '.join(bk.models())} or a built-in measured material")
+    raise ValueError(f"unknown model {shown!r}; valid models: {', '.join(registry.names())} or a built-in measured material")
 
 
 def _params(query: dict) -> dict:
     """The ``params`` query value: a JSON object (the server's depth-checked parser), ``{}`` if absent."""
-    from .server import _loads
-
-    params = _loads(_one(query, "params", "{}") or "{}", "params", 'give a JSON object like {"kd": 0.5}')
+    params = loads(_one(query, "params", "{}") or "{}", "params", 'give a JSON object like {"kd": 0.5}')
     if not isinstance(params, dict):
         raise ValueError('params: must be a JSON object like {"kd": 0.5}')
     return params
@@ -92,10 +91,7 @@ def _params(query: dict) -> dict:
 
 def web_model_class(name: str):
     """The registry class a web request names; a file path or unknown name is a one-line ValueError."""
-    import brdfkit as bk
-    from .. import registry
-
-    if isinstance(name, str) and name in bk.models():
+    if isinstance(name, str) and name in registry.names():
         return registry.get(name)
     _refuse(name)
 
@@ -107,13 +103,12 @@ def web_model(name: str, params: dict | None = None):
     request from the page must never make the server read a file of its choosing
     (nor quote a line of one in an error), so paths are refused here, in one place.
     """
-    import brdfkit as bk
     from ..measured import nbrdf
 
     if isinstance(name, str) and name in nbrdf.materials():
         if params:
             raise ValueError(f"{name}: a measured material takes no parameters")
-        return bk.material(name)
+        return nbrdf.material(name)
     return web_model_class(name)(**(params or {}))
 
 
@@ -274,11 +269,11 @@ def measured_shader(query: dict, body: bytes):
 @route("POST", "/api/merl")
 def merl_upload(query: dict, body: bytes):
     _only(query, set())
-    import brdfkit as bk
+    from ..measured.merl import load_merl
     from ..render import glsl
 
     data = _body(body, "MERL file")
-    model = _with_temp_file(data, ".binary", bk.load_merl)
+    model = _with_temp_file(data, ".binary", load_merl)
     texels = np.ascontiguousarray(glsl.table_texels(model), dtype="<f4")
     return 200, "application/octet-stream", texels.tobytes()
 
@@ -338,7 +333,6 @@ def brdf_upload(query: dict, body: bytes):
 
     from ..interchange.brdf_explorer import parse_brdf_text
     from ..render import glsl
-    from .server import _jsonable
 
     name = os.path.basename(_one(query, "name", "uploaded.brdf"))
     try:
@@ -362,7 +356,7 @@ def brdf_upload(query: dict, body: bytes):
         for k in ("min", "max"):
             if isinstance(row.get(k), float) and not math.isfinite(row[k]):
                 row[k] = None
-    return _json({"name": name, "glsl": "#version 300 es\n" + glsl.common_source() + "\n" + es, "info": _jsonable(info)})
+    return _json({"name": name, "glsl": "#version 300 es\n" + glsl.common_source() + "\n" + es, "info": jsonable(info)})
 
 
 # ---------------------------------------------------------------------------
@@ -484,16 +478,12 @@ def ibl_sampler(query: dict, body: bytes):
     """The ``bki_lobe``, ``bki_lobe_params``, ``bki_diffuse_prob`` uniforms of a model's sampler
     (:func:`brdfkit.render.ibl.sampler_uniforms`)."""
     _only(query, {"model", "params"})
-    import brdfkit as bk
     from ..render import ibl
-    from .server import _jsonable
 
     name = _one(query, "model")
     params = _params(query)
-    from ..measured import nbrdf
-
     m = web_model(name, params)
-    return _json(_jsonable(ibl.sampler_uniforms(m)))
+    return _json(jsonable(ibl.sampler_uniforms(m)))
 
 
 # ---------------------------------------------------------------------------
@@ -504,16 +494,14 @@ def validate_payload(query: dict, body: bytes):
     """``{"ok": true, "params": effective}`` or ``{"ok": false, "error": one line}`` (status 200 either way:
     a bad value is an answer here, not a failed request)."""
     _only(query, {"model", "params"})
-    import brdfkit as bk
     from ..params import to_jsonable
-    from .server import _jsonable
 
     name = _one(query, "model")
     try:
         m = web_model(name, _params(query))
     except ValueError as e:
         return _json({"ok": False, "error": str(e).strip().splitlines()[0]})
-    return _json({"ok": True, "params": _jsonable(to_jsonable(m.params))})
+    return _json({"ok": True, "params": jsonable(to_jsonable(m.params))})
 
 
 # ---------------------------------------------------------------------------
@@ -522,7 +510,6 @@ def validate_payload(query: dict, body: bytes):
 @route("GET", "/api/albedo")
 def albedo_payload(query: dict, body: bytes):
     _only(query, {"model", "params", "n"})
-    import brdfkit as bk
     from ..analysis import albedo
 
     name = _one(query, "model")

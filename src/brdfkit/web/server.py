@@ -2,8 +2,9 @@
 
 Standard library only (:mod:`http.server`), hardened for a browser and for a
 hostile page in it (see "HTTP" below). The page
-(``static/index.html``, ``app.js``, ``style.css``: plain JavaScript and WebGL 2,
-no build step, nothing fetched from outside) compiles every model's GLSL twin
+(``static/index.html``, ``style.css`` and ``static/js/``: native ES modules and
+WebGL 2, served as they are with no build step, nothing fetched from outside;
+see ``js/main.js``) compiles every model's GLSL twin
 (``render/shaders/<module>.glsl``) in the browser and renders with it.
 
 API (every answer is JSON unless said otherwise; bad input gives status 400
@@ -72,17 +73,13 @@ from urllib.parse import parse_qs, unquote, urlsplit
 
 import numpy as np
 
-from ..jsonsafe import nesting_exceeds
+from .. import registry
+from .jsonio import MAX_JSON_DEPTH, BadRequest, jsonable, loads, one_line
 
 STATIC_DIR = Path(__file__).resolve().with_name("static")
 MAX_PAIRS = 100_000
 MAX_BODY = 1 << 20  # bytes of a request body
 MAX_TARGET = 65536  # characters of the request target (path and query), http.server's own line limit
-MAX_JSON_DEPTH = 8  # nesting of the JSON in a query
-
-
-class BadRequest(ValueError):
-    """A client error: answered with status 400 and the one-line message."""
 
 
 # ---------------------------------------------------------------------------
@@ -90,14 +87,12 @@ class BadRequest(ValueError):
 # ---------------------------------------------------------------------------
 def models_payload() -> dict[str, Any]:
     """The body of ``GET /api/models``."""
-    import brdfkit as bk
-    from brdfkit import registry
-    from brdfkit.render import glsl
+    from ..render import glsl
 
     out = []
-    for name in bk.models():
+    for name in registry.names():
         cls = registry.get(name)
-        info = bk.model_info(name)
+        info = cls.info()  # what bk.model_info(name) answers
         by_name = {p.name: p for p in cls.spec}
         for row in info["params"]:
             p = by_name[row["name"]]
@@ -108,7 +103,7 @@ def models_payload() -> dict[str, Any]:
             if isinstance(row.get("min"), float) and not math.isfinite(row["min"]):
                 row["min"] = None
         info["glsl"] = glsl.has_shader(cls)
-        out.append(_jsonable(info))
+        out.append(jsonable(info))
     return {"models": out}
 
 
@@ -121,8 +116,7 @@ def _web_model_class(name: str):
 
 def shader_payload(name: str) -> str:
     """The body of ``GET /api/shader/<model>``: GLSL ES 3.00 source with its ``#version`` line."""
-    from brdfkit import registry
-    from brdfkit.render import glsl
+    from ..render import glsl
 
     try:  # an unknown model, or one without a GLSL file
         return "#version 300 es\n" + glsl.shader_source(_web_model_class(name))
@@ -135,13 +129,13 @@ def _parse_dirs(text: str, what: str) -> np.ndarray:
     if not t:
         raise BadRequest(f"{what}: missing; give x,y,z or a JSON array [x,y,z] / [[x,y,z], ...]")
     if t.startswith("["):
-        obj = _loads(t, what)
+        obj = loads(t, what)
         try:
             arr = np.asarray(obj, dtype=np.float64)
         except (TypeError, ValueError, OverflowError):
             raise BadRequest(f"{what}: expected finite numbers in [x,y,z] or [[x,y,z], ...]") from None
     else:
-        from brdfkit.params import to_float
+        from ..params import to_float
 
         parts = t.split(",")
         if len(parts) != 3:
@@ -149,7 +143,7 @@ def _parse_dirs(text: str, what: str) -> np.ndarray:
         try:
             arr = np.asarray([to_float(p, what) for p in parts], dtype=np.float64)
         except ValueError as e:
-            raise BadRequest(_one_line(e)) from None
+            raise BadRequest(one_line(e)) from None
     if arr.ndim not in (1, 2) or arr.shape[-1] != 3:
         raise BadRequest(f"{what}: expected x,y,z or [[x,y,z], ...], got shape {list(arr.shape)}")
     if arr.ndim == 2 and arr.shape[0] > MAX_PAIRS:
@@ -164,8 +158,6 @@ def _parse_dirs(text: str, what: str) -> np.ndarray:
 
 def eval_payload(query: dict[str, list[str]]) -> dict[str, Any]:
     """The body of ``GET /api/eval`` for a parsed query string."""
-    import brdfkit as bk
-
     allowed = {"model", "params", "wi", "wo"}
     for k in query:
         if k not in allowed:
@@ -175,9 +167,9 @@ def eval_payload(query: dict[str, list[str]]) -> dict[str, Any]:
             raise BadRequest(f"query parameter '{k}' given {len(v)} times; give it once")
     name = query.get("model", [""])[0]
     if not name:
-        raise BadRequest("missing query parameter 'model'; valid models: " + ", ".join(bk.models()))
+        raise BadRequest("missing query parameter 'model'; valid models: " + ", ".join(registry.names()))
     ptext = query.get("params", ["{}"])[0] or "{}"
-    params = _loads(ptext, "params", 'give a JSON object like {"kd": 0.5}')
+    params = loads(ptext, "params", 'give a JSON object like {"kd": 0.5}')
     if not isinstance(params, dict):
         raise BadRequest("params: must be a JSON object like {\"kd\": 0.5}")
     if "wi" not in query or "wo" not in query:
@@ -194,51 +186,16 @@ def eval_payload(query: dict[str, list[str]]) -> dict[str, Any]:
         m = web_model(name, params)
         value = m.eval(wi_b, wo_b)
     except (ValueError, TypeError, OverflowError) as e:
-        raise BadRequest(_one_line(e)) from None
-    from brdfkit.params import to_jsonable
+        raise BadRequest(one_line(e)) from None
+    from ..params import to_jsonable
 
     return {
         "model": name,
-        "params": _jsonable(to_jsonable(m.params)),
+        "params": jsonable(to_jsonable(m.params)),
         "wi": wi_b.tolist(),
         "wo": wo_b.tolist(),
         "value": np.asarray(value, dtype=np.float64).tolist(),
     }
-
-
-def _loads(text: str, what: str, hint: str = "") -> Any:
-    """``json.loads`` for query values: a one-line :class:`BadRequest` for bad or too deeply nested JSON."""
-    hint = f"; {hint}" if hint else ""
-    if nesting_exceeds(text, MAX_JSON_DEPTH):
-        raise BadRequest(f"{what}: JSON nested deeper than {MAX_JSON_DEPTH} levels{hint}")
-    try:
-        return json.loads(text)
-    except (json.JSONDecodeError, RecursionError, ValueError) as e:
-        msg = getattr(e, "msg", None) or type(e).__name__
-        raise BadRequest(f"{what}: not valid JSON ({msg}){hint}") from None
-
-
-def _one_line(e: BaseException) -> str:
-    lines = str(e).strip().splitlines()
-    return lines[0] if lines else type(e).__name__
-
-
-def _jsonable(obj: Any) -> Any:
-    if isinstance(obj, dict):
-        return {str(k): _jsonable(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [_jsonable(v) for v in obj]
-    if isinstance(obj, np.ndarray):
-        return _jsonable(obj.tolist())
-    if isinstance(obj, (np.floating,)):
-        obj = float(obj)
-    if isinstance(obj, (np.integer,)):
-        return int(obj)
-    if isinstance(obj, (np.bool_,)):
-        return bool(obj)
-    if isinstance(obj, float) and not math.isfinite(obj):
-        return None
-    return obj
 
 
 # ---------------------------------------------------------------------------
@@ -410,7 +367,7 @@ class Handler(BaseHTTPRequestHandler):
             else:
                 self._error(HTTPStatus.NOT_FOUND, f"not found: {_clip(path)}")
         except (BadRequest, UnicodeDecodeError) as e:
-            msg = _one_line(e) if isinstance(e, BadRequest) else "the path is not valid UTF-8"
+            msg = one_line(e) if isinstance(e, BadRequest) else "the path is not valid UTF-8"
             self._error(HTTPStatus.BAD_REQUEST, msg)
         except (BrokenPipeError, ConnectionResetError):  # pragma: no cover - the client went away
             self.close_connection = True
@@ -427,14 +384,7 @@ class Handler(BaseHTTPRequestHandler):
             return True
         if path.startswith("/api/"):
             return False
-        rel = "index.html" if path in ("", "/") else path.lstrip("/").removeprefix("static/")
-        if "\\" in rel or any(part in ("..", "") for part in rel.split("/")) or len(rel) > 255:
-            return False
-        try:
-            target = (STATIC_DIR / rel).resolve()
-            return STATIC_DIR in target.parents and target.is_file()
-        except (OSError, ValueError):
-            return False
+        return static_file(path) is not None
 
     def _builtin(self, path: str, query: str, head_only: bool) -> bool:
         """This module's own GET routes; False when ``path`` is none of them."""
@@ -462,38 +412,63 @@ class Handler(BaseHTTPRequestHandler):
         try:
             status, ctype, payload = fn(_query(query), body)
         except (ValueError, TypeError, OverflowError, RecursionError) as e:
-            raise BadRequest(_one_line(e)) from None
+            raise BadRequest(one_line(e)) from None
         self._send(int(status), bytes(payload), ctype, head_only)
         return True
 
     def _static(self, path: str, head_only: bool) -> bool:
-        if path in ("", "/"):
-            path = "/index.html"
-        rel = path.lstrip("/")
-        if rel.startswith("static/"):
-            rel = rel[len("static/"):]
-        if "\\" in rel or any(part in ("..", "") for part in rel.split("/")) or len(rel) > 255:
+        target = static_file(path)
+        if target is None:
             return False
         try:
-            target = (STATIC_DIR / rel).resolve()
-            ok = STATIC_DIR in target.parents and target.is_file()
-            data = target.read_bytes() if ok else b""
-        except (OSError, ValueError):
+            data = target.read_bytes()
+        except OSError:
             return False
-        if not ok:
-            return False
-        ctype = mimetypes.guess_type(target.name)[0] or "application/octet-stream"
-        if ctype.startswith("text/") or ctype in ("application/javascript",):
-            ctype += "; charset=utf-8"
-        self._send(HTTPStatus.OK, data, ctype, head_only)
+        self._send(HTTPStatus.OK, data, static_type(target.name), head_only)
         return True
+
+
+def static_file(path: str) -> Path | None:
+    """The file of :data:`STATIC_DIR` a URL path names (``/`` is ``index.html``; a leading
+    ``static/`` is dropped), or None: never a file outside that folder (no ``..``, no
+    backslash, no empty part, no link that leads out)."""
+    rel = "index.html" if path in ("", "/") else path.lstrip("/").removeprefix("static/")
+    if "\\" in rel or any(part in ("..", "") for part in rel.split("/")) or len(rel) > 255:
+        return None
+    try:
+        target = (STATIC_DIR / rel).resolve()
+        return target if STATIC_DIR in target.parents and target.is_file() else None
+    except (OSError, ValueError):
+        return None
+
+
+# The page's own types, whatever the system's MIME table says: the page is ES modules, which
+# a browser runs only when served with a JavaScript type (and X-Content-Type-Options: nosniff).
+STATIC_TYPES = {
+    ".html": "text/html; charset=utf-8",
+    ".js": "text/javascript; charset=utf-8",
+    ".mjs": "text/javascript; charset=utf-8",
+    ".css": "text/css; charset=utf-8",
+    ".json": "application/json; charset=utf-8",
+    ".svg": "image/svg+xml",
+    ".png": "image/png",
+}
+
+
+def static_type(name: str) -> str:
+    """The Content-Type of a static file by its name's suffix."""
+    suffix = Path(name).suffix.lower()
+    if suffix in STATIC_TYPES:
+        return STATIC_TYPES[suffix]
+    ctype = mimetypes.guess_type(name)[0] or "application/octet-stream"
+    return ctype + "; charset=utf-8" if ctype.startswith("text/") else ctype
 
 
 def _query(query: str) -> dict[str, list[str]]:
     try:
         return parse_qs(query, keep_blank_values=True, strict_parsing=False, max_num_fields=16)
     except ValueError as e:
-        raise BadRequest(f"bad query string: {_one_line(e)}") from None
+        raise BadRequest(f"bad query string: {one_line(e)}") from None
 
 
 def _clip(text: str, n: int = 80) -> str:
@@ -619,12 +594,10 @@ def make_server(host: str = "127.0.0.1", port: int = 0, *, allowed_hosts: Iterab
         raise ValueError(f"--port must be an integer in [0, 65535] (0 = any free port), got {port!r}")
     if not isinstance(host, str) or not host.strip():
         raise ValueError("--host must be a host name or an IP address, e.g. 127.0.0.1")
-    mimetypes.add_type("application/javascript", ".js")
-    mimetypes.add_type("text/css", ".css")
     try:
         return Server((host, port), Handler, allowed_hosts=allowed_hosts)
     except OSError as e:
-        reason = e.strerror or _one_line(e)
+        reason = e.strerror or one_line(e)
         raise OSError(f"cannot listen on {host}:{port}: {reason}") from None
 
 
