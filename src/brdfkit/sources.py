@@ -180,7 +180,7 @@ def _looks_like_path(text: str) -> bool:
             or (os.sep in text and head not in SETS) or text.count("/") > 1)
 
 
-def _unknown(text: str) -> ValueError:
+def _unknown(text: str, files: bool = True) -> ValueError:
     from .measured.nbrdf import SETS, materials, resolve as resolve_material
 
     names = materials()
@@ -192,9 +192,9 @@ def _unknown(text: str) -> ValueError:
     shown = text if len(text) <= 80 and text.isprintable() else repr(text[:80]) + "..."
     near = difflib.get_close_matches(text, list(registry.names()) + [n.split("/", 1)[1] for n in names], n=3, cutoff=0.6)
     hint = f"; did you mean {', '.join(near)}?" if near else ""
+    files_too = f"; or a file: {', '.join(sorted(FILE_KINDS))}" if files else ""
     return ValueError(f"unknown model {shown!r}{hint} (valid models: {', '.join(registry.names())}; "
-                      "or a built-in measured material, see `brdfkit list --measured`; "
-                      f"or a file: {', '.join(sorted(FILE_KINDS))})")
+                      f"or a built-in measured material, see `brdfkit list --measured`{files_too})")
 
 
 def identify(source: Any, *, files: bool = True) -> Source:
@@ -213,7 +213,7 @@ def identify(source: Any, *, files: bool = True) -> Source:
     kind = FILE_KINDS.get(_suffix(source))
     path_like = kind is not None or _looks_like_path(source)
     if not files:  # decided on the text alone: nothing on disk is looked at
-        raise _no_files() if path_like else _unknown(source)
+        raise _no_files() if path_like else _unknown(source, files=False)
     if not path_like and not os.path.exists(source):
         raise _unknown(source)
     if not os.path.isfile(source):

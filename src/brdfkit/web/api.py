@@ -58,7 +58,7 @@ from typing import Callable
 
 import numpy as np
 
-from .. import registry
+from ..sources import identify, resolve
 from .jsonio import jsonable, loads
 
 Handler = Callable[[dict, bytes], tuple[int, str, bytes]]
@@ -72,15 +72,6 @@ N_IN = 6
 NBRDF_VEC4 = 211  # u_nbrdf[211] in nbrdf.glsl (nbrdf_blocks)
 
 
-def _refuse(name) -> None:
-    if not isinstance(name, str):
-        raise ValueError("model: must be a name")
-    if name.endswith((".brdf", ".binary")) or name.count("/") > 1 or name.startswith((".", "/", "~")):
-        raise ValueError("model: a name is expected; file paths are not accepted over HTTP (drop the file on the page)")
-    shown = name if len(name) <= 80 and name.isprintable() else repr(name[:80]) + "..."
-    raise ValueError(f"unknown model {shown!r}; valid models: {', '.join(registry.names())} or a built-in measured material")
-
-
 def _params(query: dict) -> dict:
     """The ``params`` query value: a JSON object (the server's depth-checked parser), ``{}`` if absent."""
     params = loads(_one(query, "params", "{}") or "{}", "params", 'give a JSON object like {"kd": 0.5}')
@@ -90,26 +81,19 @@ def _params(query: dict) -> dict:
 
 
 def web_model_class(name: str):
-    """The registry class a web request names; a file path or unknown name is a one-line ValueError."""
-    if isinstance(name, str) and name in registry.names():
-        return registry.get(name)
-    _refuse(name)
+    """The registered model class a web request names (:func:`web_model`'s rules; measured data has none)."""
+    return identify(name, files=False).model_class()
 
 
 def web_model(name: str, params: dict | None = None):
     """The model a web request names: a registry name or a built-in measured material, nothing else.
 
-    ``bk.model`` also takes file paths (``.brdf``, ``.binary``) for local use; a
-    request from the page must never make the server read a file of its choosing
-    (nor quote a line of one in an error), so paths are refused here, in one place.
+    :func:`brdfkit.sources.resolve` with ``files=False``: ``bk.model`` also takes file paths
+    (``.brdf``, ``.binary``, ...) for local use, but a request from the page must never make
+    the server read a file of its choosing (nor quote a line of one in an error); the
+    resolver refuses paths from their text alone, before anything on disk is looked at.
     """
-    from ..measured import nbrdf
-
-    if isinstance(name, str) and name in nbrdf.materials():
-        if params:
-            raise ValueError(f"{name}: a measured material takes no parameters")
-        return nbrdf.material(name)
-    return web_model_class(name)(**(params or {}))
+    return resolve(name, params, files=False)
 
 
 def route(method: str, path: str):
