@@ -37,7 +37,9 @@ def register(app: typer.Typer) -> None:
     @app.command("render")
     def render_cmd(
         output: Optional[Path] = typer.Option(None, "-o", "--output", help="output image: .png (display), .exr or .npy (linear float)"),
-        scene: Optional[Path] = typer.Option(None, "--scene", help="JSON scene file; the flags below override its fields"),
+        scene: Optional[Path] = typer.Option(
+            None, "--scene", help="JSON scene file ('example': the one shipped with brdfkit); the flags below override its fields"
+        ),
         model: Optional[str] = typer.Option(None, "--model", "-m", help="a registered BRDF (see `brdfkit list`)"),
         param: Optional[List[str]] = typer.Option(None, "-p", "--param", help="model parameter name=value (repeatable)"),
         opengl_material: Optional[str] = typer.Option(
@@ -71,6 +73,7 @@ def register(app: typer.Typer) -> None:
         """Render a mesh with an OpenGL material or any BRDF (headless OpenGL)."""
         import time
 
+        from .. import examples
         from ..cli_common import model_from_cli
         from . import scene as sc
         from ..fileio import check_output_path
@@ -88,6 +91,8 @@ def register(app: typer.Typer) -> None:
         if output is None:
             raise ValueError("render needs -o/--output (or --list-envs)")
 
+        if scene is not None and str(scene) == examples.SCENE and not scene.exists():
+            scene = examples.path("scene.json")
         obj: dict[str, Any] = sc.read_scene_file(scene) if scene is not None else {}
         base = scene.parent if scene is not None else None
         if sum(x is not None for x in (model, opengl_material, measured)) > 1:
