@@ -149,3 +149,68 @@ def test_worst_asymmetry_is_the_numpy_formula_bit_for_bit(case):
         assert want == (0.5, 10 * 3 + 0)
     if case == "zeros":
         assert want == (0.0, 0)
+
+
+# --- the tolerance follows the evaluation's precision (issue 30) ----------------------------------
+
+DATA = __import__("pathlib").Path(__file__).parent / "data"
+
+PHONG_BRDF = """analytic
+
+# The lecture's Phong term read as a BRDF, (r.v)^s / (n.l): not reciprocal (test-only file).
+::begin parameters
+float ks 0 1 0.5
+float s 1 200 32
+::end parameters
+
+::begin shader
+vec3 BRDF( vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y )
+{
+    vec3 R = reflect(-L, N);
+    return vec3(ks * pow(max(dot(R, V), 0.0), s) / max(dot(N, L), 1e-4));
+}
+::end shader
+"""
+
+
+def test_evaluation_precision_is_read_from_the_values():
+    from brdfkit.analysis.reciprocity import evaluation_precision
+
+    x = np.linspace(0.1, 1.0, 1000) / np.pi
+    assert evaluation_precision(x) == "float64"
+    assert evaluation_precision(x.astype(np.float32).astype(np.float64)) == "float32"
+    assert evaluation_precision(np.zeros(10)) == "float64"
+    assert evaluation_precision(np.array([1.0, 2.0] * 500)) == "float64"  # a step of exact numbers: no evidence
+
+
+def test_float32_brdf_file_ggx_is_reciprocal_under_the_float32_tolerance():
+    """``brdfkit check tests/data/ggx.brdf -p alpha=0.3`` said "reciprocal: NO": float32 GLSL rounding
+    (7.6e-5 near grazing) judged against the float64 tolerance."""
+    from brdfkit.analysis import check
+    from brdfkit.analysis.reciprocity import RECIPROCITY_TOL, RECIPROCITY_TOL_FLOAT32
+
+    m = bk.load_brdf(DATA / "ggx.brdf", alpha=0.3)
+    r = reciprocity_report(m)
+    assert r["precision"] == "float32" and r["tolerance"] == RECIPROCITY_TOL_FLOAT32
+    assert RECIPROCITY_TOL < r["error"] < RECIPROCITY_TOL_FLOAT32 / 5  # rounding, well inside the tolerance
+    assert r["reciprocal"]
+    c = check(m, level="fast")
+    assert c["reciprocal"] and c["reciprocity_precision"] == "float32"
+    assert c["reciprocity_tolerance"] == pytest.approx(9.8e-4, rel=1e-2)
+
+
+def test_non_reciprocal_models_stay_no_in_either_precision(tmp_path):
+    r = reciprocity_report(bk.model("phong", normalized=False))
+    assert r["precision"] == "float64" and not r["reciprocal"] and r["error"] > 0.5
+    path = tmp_path / "phong.brdf"
+    path.write_text(PHONG_BRDF)
+    r = reciprocity_report(bk.load_brdf(path))
+    assert r["precision"] == "float32" and not r["reciprocal"] and r["error"] > 0.5
+
+
+def test_check_states_the_tolerance_and_precision(capsys):
+    from brdfkit.cli import main
+
+    assert main(["check", str(DATA / "ggx.brdf"), "-p", "alpha=0.3", "--level", "fast"]) == 0
+    out = capsys.readouterr().out
+    assert "reciprocal:        yes" in out and "tolerance 9.8e-04, float32 evaluation" in out

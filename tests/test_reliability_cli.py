@@ -132,8 +132,9 @@ def test_license_is_an_spdx_string():
 def test_readme_scene_example_points_at_a_shipped_file():
     root = Path(__file__).resolve().parents[1]
     readme = (root / "README.md").read_text()
-    assert "--scene docs/scene.json" in readme
-    assert (root / "docs" / "scene.json").is_file()
+    assert "--scene example" in readme  # the scene shipped in the package (brdfkit.examples), found from any folder
+    assert (root / "src" / "brdfkit" / "examples" / "scene.json").is_file()
+    assert (root / "docs" / "scene.json").is_file()  # in a clone, a link to that file
 
 
 def test_integer_options_too_large_for_c_are_exit_2(capsys):

@@ -100,3 +100,63 @@ def test_render_measured_material(tmp_path, capsys):
     assert rc == 0
     assert json.loads(capsys.readouterr().out)["size"] == [32, 32]
     assert np.asarray(Image.open(tmp_path / "al.png")).max() > 50
+
+
+# --- default lighting (issue 30): a BRDF given no lighting is lit by the studio environment ------
+
+
+def _luminance(path):
+    return (np.asarray(Image.open(path).convert("RGB")).astype(float) / 255) @ [0.2126, 0.7152, 0.0722]
+
+
+def test_default_lighting_shows_a_mirror_as_one(tmp_path, capsys):
+    """``brdfkit render --measured merl/chrome`` was a black ball (one speck of the single light):
+    object mean 0.013, 0.4 % of its pixels above 0.3 at 64 px; in the studio: 0.093 and 10 %."""
+    assert main(["render", "--opengl", "gold", "--mesh", "sphere", "--size", "64", "-o", str(tmp_path / "m.png")]) == 0
+    obj = _luminance(tmp_path / "m.png") > 0  # the sphere's pixels (gold with OpenGL's ambient is never black)
+    capsys.readouterr()
+    out = tmp_path / "chrome.png"
+    assert main(["render", "--measured", "merl/chrome", "--mesh", "sphere", "--size", "64", "-o", str(out), "--json"]) == 0
+    info = json.loads(capsys.readouterr().out)
+    assert info["environment"] == "studio" and info["samples"] == 64
+    lum = _luminance(out)
+    assert lum[~obj].max() == 0  # the environment is not drawn: the background stays black
+    assert lum[obj].mean() > 0.05 and lum[obj].max() > 0.6 and (lum[obj] > 0.3).mean() > 0.03
+    # --env none: the point light as before, the black ball
+    assert main(["render", "--measured", "merl/chrome", "--mesh", "sphere", "--size", "64", "--env", "none",
+                 "-o", str(out), "--json"]) == 0
+    assert "environment" not in json.loads(capsys.readouterr().out)
+    assert _luminance(out)[obj].mean() < 0.03
+
+
+def test_default_lighting_leaves_opengl_scenes_and_flat_shading_alone(tmp_path, capsys):
+    for args in (["--opengl", "gold"], ["--model", "cook-torrance", "--shading", "gouraud"]):
+        assert main(["render", *args, "--mesh", "sphere", "--size", "16", "-o", str(tmp_path / "a.png"), "--json"]) == 0
+        assert "environment" not in json.loads(capsys.readouterr().out)
+    # a scene file's lights win
+    scene = {"mesh": "sphere", "size": [16, 16], "material": {"model": "lambert"},
+             "lights": [{"position": [0, 0, 1, 0], "diffuse": [1, 1, 1]}]}
+    (tmp_path / "s.json").write_text(json.dumps(scene))
+    assert main(["render", "--scene", str(tmp_path / "s.json"), "-o", str(tmp_path / "b.png"), "--json"]) == 0
+    assert "environment" not in json.loads(capsys.readouterr().out)
+
+
+def test_samples_apply_to_the_default_environment(tmp_path, capsys):
+    rc = main(["render", "--model", "lambert", "--mesh", "sphere", "--size", "16", "--samples", "8",
+               "-o", str(tmp_path / "a.png"), "--json"])
+    assert rc == 0 and json.loads(capsys.readouterr().out)["samples"] == 8
+    rc = main(["render", "--opengl", "gold", "--samples", "8", "-o", str(tmp_path / "b.png")])
+    err = capsys.readouterr().err
+    assert rc == 2 and "--samples needs environment lighting" in err and not (tmp_path / "b.png").exists()
+
+
+def test_example_scene_is_found_from_any_folder(tmp_path, capsys, monkeypatch):
+    from brdfkit import examples
+
+    monkeypatch.chdir(tmp_path)
+    assert main(["render", "--scene", "example", "--size", "24", "-o", "scene.png", "--json"]) == 0
+    info = json.loads(capsys.readouterr().out)
+    assert info["material"] == "cook-torrance" and (tmp_path / "scene.png").is_file()
+    assert examples.path("scene.json").is_file() and examples.path("ggx.brdf").is_file()
+    with pytest.raises(ValueError, match="unknown example"):
+        examples.path("nope.json")

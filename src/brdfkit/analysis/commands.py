@@ -133,7 +133,7 @@ def register(app: typer.Typer) -> None:
             f"  reciprocal:        {'yes' if r['reciprocal'] else 'NO'} (largest relative asymmetry "
             f"{r['reciprocity_error']:.2e}"
             + ("" if r["reciprocal"] else f" at wi={w['wi_deg']}°, wo={w['wo_deg']}°")
-            + ")"
+            + f"; tolerance {r['reciprocity_tolerance']:.1e}, {r['reciprocity_precision']} evaluation)"
         )
         typer.echo(
             f"  energy conserving: {'yes' if r['energy_conserving'] else 'NO'} (max albedo {r['max_albedo']:.6f} "

@@ -12,6 +12,15 @@ one that is zero in one direction and not in the other. Pairs where both
 values are negligible (below 1e-12 of the largest value seen) are skipped:
 their ratio is rounding noise.
 
+The tolerance follows the precision the model is evaluated in
+(:func:`evaluation_precision`): :data:`RECIPROCITY_TOL` (1e-6) for float64,
+:data:`RECIPROCITY_TOL_FLOAT32` (8192 float32 ulps, 9.8e-4) for a model that
+computes in float32 — a BRDF Explorer ``.brdf`` shader runs as float32 GLSL,
+and near grazing its rounding alone makes a symmetric formula asymmetric by
+up to 7.6e-5 (``tests/data/ggx.brdf``, alpha = 0.3; the engine's float32
+twins: up to 3.3e-5, Schlick). A model that breaks the law does so by far
+more (the unnormalized Phong lobe: order 1).
+
 The direction set (:func:`direction_pairs`) combines
 
 * every pair of a grid of 18 polar angles (0° to 89.9°, grazing ones
@@ -32,8 +41,14 @@ import numpy as np
 from ..engine import jit
 from ..geometry import spherical_to_vector
 
-#: a model is called reciprocal when its relative asymmetry is at most this
+#: a model evaluated in float64 is called reciprocal when its relative asymmetry is at most this
 RECIPROCITY_TOL = 1e-6
+
+#: the same for a model evaluated in float32: 2^13 float32 ulps (9.8e-4), ten times the largest
+#: rounding asymmetry measured for a symmetric float32 formula (7.6e-5, see the module docstring)
+RECIPROCITY_TOL_FLOAT32 = 2.0**13 * float(np.finfo(np.float32).eps)
+
+_TOLERANCE = {"float64": RECIPROCITY_TOL, "float32": RECIPROCITY_TOL_FLOAT32}
 
 _THETA_DEG = (0.0, 0.5, 2.0, 5.0, 10.0, 20.0, 30.0, 40.0, 50.0, 60.0, 70.0, 75.0, 80.0, 85.0, 88.0, 89.0, 89.5, 89.9)
 _N_PHI = 24
@@ -101,17 +116,48 @@ def worst_asymmetry(fab, fba):
     return worst, at
 
 
+def evaluation_precision(*values: np.ndarray) -> str:
+    """``"float32"`` if every non-zero value (of float64 arrays a model returned for float64
+    directions) is a float32 number, else ``"float64"``.
+
+    A model that computes in float32 (a ``.brdf`` shader on the GL context) can only return such
+    values; a float64 computation returns one by chance about once in 2^29 values, and the test
+    set has hundreds of thousands. Fewer than :data:`MIN_DISTINCT` distinct non-zero values (a
+    constant, a step function of exact numbers such as 1 and 2) say nothing of the precision:
+    ``"float64"``, the stricter tolerance.
+    """
+    nz = np.concatenate([np.asarray(v, dtype=np.float64).ravel() for v in values])
+    nz = nz[nz != 0]
+    if np.unique(nz).size < MIN_DISTINCT:
+        return "float64"
+    return "float32" if np.array_equal(nz.astype(np.float32).astype(np.float64), nz) else "float64"
+
+
+#: distinct non-zero values :func:`evaluation_precision` needs before it calls a model float32
+MIN_DISTINCT = 64
+
+
+def reciprocity_tolerance(precision: str) -> float:
+    """The largest relative asymmetry a model evaluated in ``precision`` may show and be called reciprocal."""
+    if precision not in _TOLERANCE:
+        raise ValueError(f"precision must be one of {', '.join(_TOLERANCE)}, got {precision!r}")
+    return _TOLERANCE[precision]
+
+
 def reciprocity_report(model: Any, *, n_random: int = 20000, seed: int = 20241) -> dict[str, Any]:
     """Largest relative asymmetry and where it occurs.
 
-    Returns ``{"error", "reciprocal", "worst": {"wi_deg": [θ, φ], "wo_deg": [θ, φ],
-    "f_wi_wo": rgb, "f_wo_wi": rgb}, "pairs": N}``.
+    Returns ``{"error", "reciprocal", "precision", "tolerance", "worst": {"wi_deg": [θ, φ],
+    "wo_deg": [θ, φ], "f_wi_wo": rgb, "f_wo_wi": rgb}, "pairs": N}``: ``reciprocal`` is
+    ``error <= tolerance``, the tolerance of the model's evaluation ``precision``.
     """
     a, b = direction_pairs(n_random, seed)
     fab = np.asarray(model.eval(a, b), dtype=np.float64)
     fba = np.asarray(model.eval(b, a), dtype=np.float64)
     if not (np.all(np.isfinite(fab)) and np.all(np.isfinite(fba))):
         raise ValueError(f"{getattr(model, 'name', 'model')}: eval returned NaN or Inf; reciprocity undefined")
+    precision = evaluation_precision(fab, fba)
+    tol = reciprocity_tolerance(precision)
     err, flat = worst_asymmetry(np.ascontiguousarray(fab), np.ascontiguousarray(fba))
     k, ch = divmod(int(flat), 3)
     err = float(err)
@@ -124,7 +170,9 @@ def reciprocity_report(model: Any, *, n_random: int = 20000, seed: int = 20241) 
 
     return {
         "error": err,
-        "reciprocal": bool(err <= RECIPROCITY_TOL),
+        "reciprocal": bool(err <= tol),
+        "precision": precision,
+        "tolerance": tol,
         "worst": {
             "wi_deg": deg(a[k]),
             "wo_deg": deg(b[k]),
@@ -141,9 +189,13 @@ def reciprocity_error(model: Any, *, n_random: int = 20000, seed: int = 20241) -
 
     0 (to rounding) for a reciprocal model; see :func:`reciprocity_report` for
     the pair where it occurs. The model is called reciprocal when this is at
-    most :data:`RECIPROCITY_TOL` (1e-6).
+    most :data:`RECIPROCITY_TOL` (1e-6), or :data:`RECIPROCITY_TOL_FLOAT32` for a
+    model evaluated in float32.
     """
     return float(reciprocity_report(model, n_random=n_random, seed=seed)["error"])
 
 
-__all__ = ["reciprocity_error", "reciprocity_report", "direction_pairs", "RECIPROCITY_TOL"]
+__all__ = [
+    "reciprocity_error", "reciprocity_report", "direction_pairs", "evaluation_precision", "reciprocity_tolerance",
+    "RECIPROCITY_TOL", "RECIPROCITY_TOL_FLOAT32",
+]

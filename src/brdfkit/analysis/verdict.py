@@ -11,7 +11,7 @@ import numpy as np
 from .. import registry, sources
 from ..geometry import rotate_z
 from .albedo import DEFAULT_LEVEL, albedo_result
-from .reciprocity import RECIPROCITY_TOL, reciprocity_report
+from .reciprocity import reciprocity_report
 
 #: polar angles (degrees) of the albedo scan: every 5° to 85°, then 87°, 88°, 89°
 DEFAULT_THETA_DEG = tuple(float(x) for x in list(range(0, 90, 5)) + [87, 88, 89])
@@ -98,8 +98,10 @@ def check(
     ``model``, ``params``
         registry name and effective parameters;
     ``reciprocal``, ``reciprocity_error``, ``reciprocity_worst``
-        largest relative asymmetry over the test pairs (reciprocal if ≤ 1e-6) and
-        where it occurs;
+        largest relative asymmetry over the test pairs (reciprocal if ≤ 1e-6, or 9.8e-4 for a
+        model evaluated in float32) and where it occurs;
+    ``reciprocity_tolerance``, ``reciprocity_precision``
+        that tolerance and the precision (``float64``/``float32``) it follows;
     ``albedo``
         ``theta_deg``, ``rgb`` (largest over the scanned azimuths ``phi_deg``),
         ``error`` (integration error estimate) of a(wo) = ∫ f cos θi dωi;
@@ -167,7 +169,8 @@ def check(
         "params": model.params_json() if hasattr(model, "params_json") else dict(getattr(model, "params", {})),
         "reciprocal": bool(rec["reciprocal"]),
         "reciprocity_error": float(rec["error"]),
-        "reciprocity_tolerance": RECIPROCITY_TOL,
+        "reciprocity_tolerance": rec["tolerance"],
+        "reciprocity_precision": rec["precision"],
         "reciprocity_worst": rec["worst"],
         "energy_conserving": bool(conserving),
         "max_albedo": mx,

@@ -37,7 +37,9 @@ def register(app: typer.Typer) -> None:
     @app.command("render")
     def render_cmd(
         output: Optional[Path] = typer.Option(None, "-o", "--output", help="output image: .png (display), .exr or .npy (linear float)"),
-        scene: Optional[Path] = typer.Option(None, "--scene", help="JSON scene file; the flags below override its fields"),
+        scene: Optional[Path] = typer.Option(
+            None, "--scene", help="JSON scene file ('example': the one shipped with brdfkit); the flags below override its fields"
+        ),
         model: Optional[str] = typer.Option(None, "--model", "-m", help="a registered BRDF (see `brdfkit list`)"),
         param: Optional[List[str]] = typer.Option(None, "-p", "--param", help="model parameter name=value (repeatable)"),
         opengl_material: Optional[str] = typer.Option(
@@ -58,20 +60,26 @@ def register(app: typer.Typer) -> None:
         srgb: Optional[bool] = typer.Option(None, "--srgb/--no-srgb", help="sRGB-encode the picture"),
         backend: str = typer.Option("auto", "--backend", help="auto | glsl | numpy"),
         env: Optional[str] = typer.Option(
-            None, "--env", help="image-based lighting: a built-in environment (see --list-envs) or an .exr/.hdr map"
+            None,
+            "--env",
+            help="image-based lighting: a built-in environment (see --list-envs) or an .exr/.hdr map; "
+            "'none' for the point lights. Default for a BRDF or measured material with phong shading "
+            "and no lights in the scene file: studio, not drawn behind the object",
         ),
-        samples: Optional[int] = typer.Option(None, "--samples", help="samples per pixel with --env (default 64)"),
+        samples: Optional[int] = typer.Option(None, "--samples", help="samples per pixel of environment lighting (default 64)"),
         list_envs: bool = typer.Option(False, "--list-envs", help="list the built-in environments and exit"),
         as_json: bool = typer.Option(False, "--json", help="print what was rendered as JSON"),
     ) -> None:
         """Render a mesh with an OpenGL material or any BRDF (headless OpenGL)."""
         import time
 
+        from .. import examples
         from ..cli_common import model_from_cli
         from . import scene as sc
         from ..fileio import check_output_path
-        from .environment import BUILTINS
+        from .environment import BUILTINS, environment_from_spec
         from .image import IMAGE_SUFFIXES
+        from .lighting import DEFAULT_ENVIRONMENT, uses_default_environment
 
         if list_envs:
             if as_json:
@@ -83,6 +91,8 @@ def register(app: typer.Typer) -> None:
         if output is None:
             raise ValueError("render needs -o/--output (or --list-envs)")
 
+        if scene is not None and str(scene) == examples.SCENE and not scene.exists():
+            scene = examples.path("scene.json")
         obj: dict[str, Any] = sc.read_scene_file(scene) if scene is not None else {}
         base = scene.parent if scene is not None else None
         if sum(x is not None for x in (model, opengl_material, measured)) > 1:
@@ -129,14 +139,20 @@ def register(app: typer.Typer) -> None:
             obj["srgb"] = srgb
         if material is not None:
             obj["material"] = material  # an object: scene_from_json takes it as it is
-        if env is not None:
+        if env == "none":
+            obj.pop("environment", None)
+        elif env is not None:
             obj["environment"] = {"name": env} if env in BUILTINS else {"path": str(Path(env).absolute())}
-        if samples is not None:
-            if not isinstance(obj.get("environment"), dict):
-                raise ValueError("--samples needs --env (or an environment in the scene file)")
+        if samples is not None and isinstance(obj.get("environment"), dict):
             obj["environment"] = {**obj["environment"], "samples": samples}
         # the look: the material's defaults, then the scene file's fields, then the flags (already in obj)
         parsed, look = sc.scene_from_json(obj, base_dir=base)
+        if env != "none" and uses_default_environment(parsed, lights_given=obj.get("lights") is not None):
+            default_env = {**DEFAULT_ENVIRONMENT, **({"samples": samples} if samples is not None else {})}
+            parsed.environment, asked = environment_from_spec(default_env)
+            parsed.samples = asked or parsed.samples
+        if samples is not None and parsed.environment is None:
+            raise ValueError("--samples needs environment lighting (--env, an environment in the scene file, or the default for a BRDF)")
         check_output_path(output, what="image", suffixes=IMAGE_SUFFIXES, notify=lambda m: typer.echo(f"brdfkit: {m}", err=True))
         t0 = time.perf_counter()
         frame = sc.render(parsed, look, backend=backend)
@@ -159,7 +175,8 @@ def register(app: typer.Typer) -> None:
         if as_json:
             typer.echo(json.dumps(info))
         else:
-            typer.echo(f"wrote {output} ({parsed.size[0]}x{parsed.size[1]}, {parsed.mesh.n_triangles} triangles, {dt:.2f} s)")
+            lit = f", {parsed.environment.name} environment" if parsed.environment is not None else ""
+            typer.echo(f"wrote {output} ({parsed.size[0]}x{parsed.size[1]}, {parsed.mesh.n_triangles} triangles{lit}, {dt:.2f} s)")
 
     @app.command("gallery")
     def gallery_cmd(

@@ -40,7 +40,30 @@ from .. import opengl
 from ..geometry import dot, normalize, to_local
 from ..opengl import Light, LightModel, light_vector
 
-__all__ = ["light_vector", "orthonormal_tangent", "ambient_albedo", "brdf_shade", "shade_points"]
+__all__ = [
+    "light_vector", "orthonormal_tangent", "ambient_albedo", "brdf_shade", "shade_points",
+    "DEFAULT_ENVIRONMENT", "uses_default_environment",
+]
+
+DEFAULT_ENVIRONMENT = {"name": "studio", "visible": False}
+"""How ``brdfkit render`` lights a BRDF or measured material when it is given no lighting.
+
+The built-in ``studio`` (three soft boxes, :mod:`brdfkit.render.environment`), as the gallery's
+environment-lit figures use it, not drawn behind the object (the scene's ``background`` stays).
+A single point light shows a near-mirror (``merl/chrome``) as a black object with a speck; the
+soft boxes show it as what it is. OpenGL fixed-function materials keep the classic light
+(:data:`brdfkit.render.scene.DEFAULT_LIGHTS`): environment lighting needs a BRDF."""
+
+
+def uses_default_environment(scene: Any, lights_given: bool) -> bool:
+    """Whether :data:`DEFAULT_ENVIRONMENT` lights ``scene``: a BRDF material, per-pixel (phong)
+    shading, and neither an environment nor lights given (by the scene file or the flags)."""
+    return (
+        not scene.is_opengl
+        and scene.environment is None
+        and not lights_given
+        and scene.shading == "phong"
+    )
 
 
 def orthonormal_tangent(n: np.ndarray, t: np.ndarray) -> np.ndarray:
