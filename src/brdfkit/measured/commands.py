@@ -31,10 +31,10 @@ def measured_names(set_name: str | None = None) -> list[str]:
 
 def _fixed_for(model_name: str, items: List[str], strict: bool) -> dict[str, Any]:
     """Parse ``-p name=value``; with ``strict=False`` skip names the model lacks."""
-    from .. import registry
     from ..params import parse_assignments
+    from ..sources import model_class
 
-    cls = registry.get(model_name)
+    cls = model_class(model_name)
     if strict:
         return parse_assignments(model_name, cls.spec, items)
     names = {p.name for p in cls.spec}
@@ -88,10 +88,10 @@ def parse_model_spec(text: str) -> tuple[str, str, list[str]]:
 
     The same model can so appear twice with different options, e.g. ``ward`` and
     ``ward:normalization=dur`` (Ngan et al.'s Ward and Ward-Dür); the label is the text given."""
-    from .. import registry
+    from ..sources import model_class
 
     name, *items = [x.strip() for x in text.split(":")]
-    registry.get(name)
+    model_class(name)
     for it in items:
         if "=" not in it:
             raise ValueError(f"--model {text!r}: expected NAME:name=value, got {it!r}")

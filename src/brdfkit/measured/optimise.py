@@ -298,9 +298,9 @@ def _model_class(name: str | type[BRDF], lobes: int, fixed: Mapping[str, Any] | 
                  ) -> tuple[type[BRDF], dict[str, Any]]:
     """The class :func:`fit` fits and its fixed values: with ``lobes=2`` a model's own ``lobes``
     parameter set to 2 (Lafortune), else the :func:`~brdfkit.measured.lobes.two_lobe` class."""
-    from .. import registry
+    from ..sources import model_class
 
-    cls = name if isinstance(name, type) and issubclass(name, BRDF) else registry.get(name)
+    cls = name if isinstance(name, type) and issubclass(name, BRDF) else model_class(name)
     fixed = dict(fixed or {})
     if lobes == 2:
         if any(p.name == "lobes" for p in cls.spec):
