@@ -7,7 +7,6 @@
 
 from __future__ import annotations
 
-import json
 import os
 import time
 from typing import Any, List, Optional
@@ -55,20 +54,6 @@ def _fmt_params(params: dict[str, Any]) -> str:
 
 
 # --------------------------------------------------------------------------- batch output
-def write_batch(results, models: list[str], sources: list[str], out_dir: str, metric: str, seconds: float) -> dict[str, str]:
-    """CSV, Markdown, sorted-error PNGs and parameters JSON of a batch of FitResults; returns the paths."""
-    from .batch import Job, write_tables
-
-    os.makedirs(out_dir, exist_ok=True)
-    recs, jobs = [], []
-    for r in results:
-        rec = r.to_json()
-        rec["column"] = r.model.name
-        recs.append(rec)
-        jobs.append(Job(r.source, r.model.name, r.model.name))
-    return write_tables(recs, jobs, list(models), list(sources), out_dir, metric, seconds)
-
-
 def parse_samples(text: str) -> int | str:
     """``--samples``: a number (at least 16) or ``table`` (every measured bin)."""
     t = str(text).strip().lower()
