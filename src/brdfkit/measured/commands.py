@@ -53,7 +53,6 @@ def _fmt_params(params: dict[str, Any]) -> str:
     return " ".join(parts)
 
 
-# --------------------------------------------------------------------------- batch output
 def parse_samples(text: str) -> int | str:
     """``--samples``: a number (at least 16) or ``table`` (every measured bin)."""
     t = str(text).strip().lower()
