@@ -159,7 +159,7 @@ class _AsSamplable(BRDF):
     def __init__(self, inner: BRDF) -> None:
         super().__init__()
         self.inner = inner
-        self.label = getattr(inner, "label", None) or getattr(inner, "name", "model")
+        self.label = inner.label or inner.name or "model"
 
     def eval(self, wi, wo):
         return self.inner.eval(wi, wo)
@@ -197,7 +197,7 @@ def _fit(target: type[BRDF], model: BRDF, data, metric: str, fixed: dict[str, An
 
 # --------------------------------------------------------------------------- sources
 def _is(model: BRDF, name: str) -> bool:
-    return getattr(type(model), "name", None) == name
+    return type(model).name == name
 
 
 def _is_eon(model: BRDF) -> bool:
@@ -337,7 +337,7 @@ def mitsuba_xml(d: dict[str, Any], ident: str = "material") -> str:
 
 def mitsuba_dict(model: BRDF, metric: str = "ngan", data=None) -> tuple[dict[str, Any], dict[str, Any]]:
     """The ``mi.load_dict`` dict for a model, and what went into it (exact, error, method, note)."""
-    p = getattr(model, "params", {})
+    p = model.params
     info: dict[str, Any] = {"exact": False, "error": None, "relative_error": None, "method": "direct", "note": ""}
     if _is(model, "lambert"):
         info.update(exact=True, note="lambert -> diffuse")
@@ -418,14 +418,14 @@ def _microfacet_target(model: BRDF) -> type[BRDF]:
     from .. import registry
 
     cls = registry.get("microfacet")
-    if getattr(model, "isotropic", True):
+    if model.isotropic:
         return cls
     spec = tuple(replace(p, fit=False) if p.name == "alpha" else p for p in cls.spec)
     return type("MicrofacetAnisotropicFit", (cls,), {"spec": spec, "isotropic": True, "__module__": cls.__module__})
 
 
 def _is_isotropic(model: BRDF) -> bool:
-    return bool(getattr(model, "isotropic", True))
+    return bool(model.isotropic)
 
 
 # --------------------------------------------------------------------------- OpenPBR / MaterialX
@@ -444,7 +444,7 @@ def conductor_f0_f82(eta, k) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _openpbr_direct(model: BRDF) -> tuple[dict[str, Any] | None, bool, str]:
-    p = getattr(model, "params", {})
+    p = model.params
     if _is(model, "lambert"):
         return {"base_weight": 1.0, "base_color": _rgb(p["kd"]), "base_metalness": 0.0, "specular_weight": 0.0}, True, (
             "lambert -> base_color = kd, specular_weight = 0"
@@ -594,7 +594,7 @@ def materialx_text(doc) -> str:
 
 # --------------------------------------------------------------------------- glTF
 def _gltf_direct(model: BRDF) -> tuple[dict[str, Any] | None, bool, str]:
-    p = getattr(model, "params", {})
+    p = model.params
     if _is(model, "lambert"):
         return {"base_color": _rgb(p["kd"]), "metallic": 0.0, "roughness": 1.0, "specular": 0.0}, True, (
             "lambert -> baseColor = kd, KHR_materials_specular.specularFactor = 0"
@@ -741,7 +741,7 @@ def export(model: BRDF, fmt: str, path: str | os.PathLike, *, metric: str = "nga
     if not isinstance(model, BRDF):
         raise ValueError(f"export: expected a model, got {type(model).__name__}")
     p = _check_path(path, fmt)
-    label = name or str(getattr(model, "label", None) or type(model).name or "material")
+    label = name or str(model.label or type(model).name or "material")
     if fmt == "mitsuba":
         d, info = mitsuba_dict(model, metric)
         text = _json_text(d) if p.suffix.lower() == ".json" else mitsuba_xml(d)

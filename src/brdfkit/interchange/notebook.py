@@ -133,9 +133,9 @@ def _img(png: bytes, alt: str) -> str:
 def model_html(model: Any) -> str:
     """HTML: the model's name, reference and parameters, and :func:`model_png`."""
     cls = type(model)
-    title = html.escape(f"{getattr(cls, 'name', cls.__name__)} — {getattr(cls, 'title', '')}".strip(" —"))
-    ref = html.escape(getattr(cls, "reference", "") or "")
-    params = getattr(model, "params", {}) or {}
+    title = html.escape(f"{cls.name or cls.__name__} — {cls.title}".strip(" —"))
+    ref = html.escape(cls.reference or "")
+    params = model.params or {}
     return (
         f"<div class='brdfkit-model'><b>{title}</b><br/><small>{ref}</small>"
         f"<div style='display:flex;gap:1em;align-items:flex-start'>{_table(params)}"
