@@ -89,3 +89,35 @@ def test_ipython_display_formatter_shows_model_and_fit():
     data, _ = fmt.format(r)
     assert "text/html" in data and "fit of lambert" in data["text/html"]
     assert IPython.version_info >= (8,)
+
+
+def test_model_png_sphere_has_a_margin_in_its_tile():
+    """The sphere does not touch its tile's edges (the left one is the picture's edge): on the
+    centre row and column, the first and last pixels of the tile are background grey."""
+    img = _decode(bk.model("lambert", kd=0.8)._repr_png_())
+    h = img.shape[0]
+    s = max(notebook.SPHERE_SIZE, int(h * 0.8))
+    top = (h - s) // 2
+    tile = img[top : top + s, :s]
+    m = int(round(notebook.SPHERE_MARGIN * s))
+    assert m >= 2
+    row, col = tile[s // 2], tile[:, s // 2]
+    for line in (row, col):
+        np.testing.assert_allclose(line[:m], 0.15, atol=2 / 255)
+        np.testing.assert_allclose(line[-m:], 0.15, atol=2 / 255)
+    # the light (φ = 135°) is at the upper left: the left and top limbs are lit right after the margin
+    assert tile[s // 2, m + 1].mean() > 0.3 and tile[m + 1, s // 2].mean() > 0.3
+
+
+def test_models_package_does_not_import_interchange():
+    """Jupyter display is attached by brdfkit/__init__.py; brdfkit.models.base has no import of interchange."""
+    import ast
+    import inspect
+
+    from brdfkit.models import base
+
+    tree = ast.parse(inspect.getsource(base))
+    mods = [n.module or "" for n in ast.walk(tree) if isinstance(n, ast.ImportFrom)]
+    mods += [a.name for n in ast.walk(tree) if isinstance(n, ast.Import) for a in n.names]
+    assert not [m for m in mods if "interchange" in m], mods
+    assert callable(bk.BRDF._repr_png_) and callable(bk.BRDF._repr_html_)

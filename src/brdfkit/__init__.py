@@ -100,3 +100,22 @@ def export(model, fmt: str, path, **kw):
 
 
 __all__ += ["load_brdf", "export"]
+
+
+# -- Jupyter display: attached to BRDF here, so that brdfkit.models never imports interchange;
+#    the work (and the import of brdfkit.interchange.notebook) happens on the first display ---
+def _attach_notebook_display(cls: type) -> None:
+    def _repr_png_(self) -> bytes:
+        from .interchange.notebook import model_png
+
+        return model_png(self)
+
+    def _repr_html_(self) -> str:
+        from .interchange.notebook import model_html
+
+        return model_html(self)
+
+    cls._repr_png_, cls._repr_html_ = _repr_png_, _repr_html_
+
+
+_attach_notebook_display(BRDF)

@@ -97,7 +97,7 @@ def eval_result(m: Any, wi: np.ndarray, wo: np.ndarray) -> dict[str, Any]:
     """What ``brdfkit eval --json`` prints for the model ``m`` at unit directions ``wi``, ``wo`` (3,)."""
     f = m.eval(wi, wo)
     return {
-        "model": getattr(m, "label", m.name),
+        "model": getattr(m, "label", None) or m.name,
         "params": m.params_json(),
         "wi": [float(x) for x in wi],
         "wo": [float(x) for x in wo],

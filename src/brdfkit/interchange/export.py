@@ -49,8 +49,15 @@ specular_color = the F82 tint that makes the F82-tint Fresnel equal the
 conductor's at 82°; exact only at those two angles, error stated), by fitting
 otherwise (the direct mapping is the fit's first start). Standard Surface gets
 the same values under its names (base, base_color, metalness, specular,
-specular_color, specular_roughness, specular_IOR, specular_anisotropy); its
-own error is not measured.
+specular_color, specular_roughness, specular_IOR, specular_anisotropy,
+diffuse_roughness); its own error is not measured.
+
+``oren-nayar`` ``variant="eon"`` (Portsmouth, Kutz & Hill 2025) is exact twice over:
+OpenPBR 1.1's diffuse base IS that model (base_color = kd, base_diffuse_roughness =
+r = min(σ, 1), specular_weight = 0), and the document gets a third material, the bare
+``oren_nayar_diffuse_bsdf`` (color = kd, roughness = r, energy_compensation = true)
+in a ``surface`` (MaterialX 1.39). Standard Surface's ``diffuse_roughness`` drives the
+uncompensated (qualitative) Oren-Nayar: close, not the same model.
 
 glTF (``fmt="gltf"``)
 ---------------------
@@ -59,8 +66,10 @@ material as ``pbrMetallicRoughness`` plus ``KHR_materials_ior`` and
 ``KHR_materials_specular`` when they differ from their defaults. Parameters
 from :class:`~brdfkit.interchange.targets.GltfPBR`: exact for ``lambert``
 (specularFactor 0) and for a GGX/smith/Schlick ``microfacet`` with kd = 0,
-ks = 1, isotropic (metallic 1, baseColor = f0, roughness = sqrt(alpha));
-fitted otherwise.
+ks = 1, isotropic (metallic 1, baseColor = f0, roughness = sqrt(alpha)), and for
+``oren-nayar`` ``variant="eon"`` (baseColor = kd, specularFactor 0, and the draft
+``KHR_materials_diffuse_roughness`` with diffuseRoughnessFactor = r = min(σ, 1), whose
+diffuse lobe is OpenPBR's EON); fitted otherwise.
 """
 
 from __future__ import annotations
@@ -150,7 +159,7 @@ class _AsSamplable(BRDF):
     def __init__(self, inner: BRDF) -> None:
         super().__init__()
         self.inner = inner
-        self.label = getattr(inner, "label", None) or getattr(inner, "name", "model")
+        self.label = inner.label or inner.name or "model"
 
     def eval(self, wi, wo):
         return self.inner.eval(wi, wo)
@@ -188,7 +197,16 @@ def _fit(target: type[BRDF], model: BRDF, data, metric: str, fixed: dict[str, An
 
 # --------------------------------------------------------------------------- sources
 def _is(model: BRDF, name: str) -> bool:
-    return getattr(type(model), "name", None) == name
+    return type(model).name == name
+
+
+def _is_eon(model: BRDF) -> bool:
+    return _is(model, "oren-nayar") and model.params["variant"] == "eon"
+
+
+def eon_roughness(params: dict[str, Any]) -> float:
+    """EON's roughness r of an ``oren-nayar`` ``variant="eon"`` model: min(σ, 1) (:mod:`brdfkit.models.oren_nayar`)."""
+    return min(float(params["sigma"]), 1.0)
 
 
 def _microfacet_conductor(params: dict[str, Any]) -> tuple[dict[str, Any], bool]:
@@ -319,7 +337,7 @@ def mitsuba_xml(d: dict[str, Any], ident: str = "material") -> str:
 
 def mitsuba_dict(model: BRDF, metric: str = "ngan", data=None) -> tuple[dict[str, Any], dict[str, Any]]:
     """The ``mi.load_dict`` dict for a model, and what went into it (exact, error, method, note)."""
-    p = getattr(model, "params", {})
+    p = model.params
     info: dict[str, Any] = {"exact": False, "error": None, "relative_error": None, "method": "direct", "note": ""}
     if _is(model, "lambert"):
         info.update(exact=True, note="lambert -> diffuse")
@@ -372,6 +390,10 @@ def mitsuba_dict(model: BRDF, metric: str = "ngan", data=None) -> tuple[dict[str
     # (ks free as well, so that kd + ks <= 1 stays reachable: Mitsuba's reflectances must lie in [0, 1])
     data = data if data is not None else _samples(model)
     fixed = {"distribution": "ggx", "fresnel": "conductor", "shadowing": "smith"}
+    if _is(model, "microfacet") and max(_rgb(p["kd"])) == 0.0:
+        # no diffuse term in the source: none in the fit either (a free kd would settle at a few 1e-3
+        # and push kd + ks over 1, which Mitsuba's blend then has to clamp)
+        fixed["kd"] = 0.0
     start = None
     if _is(model, "microfacet"):  # another microfacet variant: its own values are the first start
         start = {k: p[k] for k in ("alpha_x", "alpha_y", "kd", "ks") if p.get(k) is not None}
@@ -396,14 +418,14 @@ def _microfacet_target(model: BRDF) -> type[BRDF]:
     from .. import registry
 
     cls = registry.get("microfacet")
-    if getattr(model, "isotropic", True):
+    if model.isotropic:
         return cls
     spec = tuple(replace(p, fit=False) if p.name == "alpha" else p for p in cls.spec)
     return type("MicrofacetAnisotropicFit", (cls,), {"spec": spec, "isotropic": True, "__module__": cls.__module__})
 
 
 def _is_isotropic(model: BRDF) -> bool:
-    return bool(getattr(model, "isotropic", True))
+    return bool(model.isotropic)
 
 
 # --------------------------------------------------------------------------- OpenPBR / MaterialX
@@ -422,10 +444,16 @@ def conductor_f0_f82(eta, k) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _openpbr_direct(model: BRDF) -> tuple[dict[str, Any] | None, bool, str]:
-    p = getattr(model, "params", {})
+    p = model.params
     if _is(model, "lambert"):
         return {"base_weight": 1.0, "base_color": _rgb(p["kd"]), "base_metalness": 0.0, "specular_weight": 0.0}, True, (
             "lambert -> base_color = kd, specular_weight = 0"
+        )
+    if _is_eon(model):
+        return {"base_weight": 1.0, "base_color": _rgb(p["kd"]), "base_metalness": 0.0, "specular_weight": 0.0,
+                "base_diffuse_roughness": eon_roughness(p)}, True, (
+            "oren-nayar eon -> base_color = kd, base_diffuse_roughness = min(sigma, 1), specular_weight = 0 "
+            "(OpenPBR's diffuse is EON)"
         )
     if _is(model, "microfacet") and p["distribution"] == "ggx":
         ax, ay = float(p["alpha_x"]), float(p["alpha_y"])
@@ -504,11 +532,18 @@ _SS_NAMES = {  # OpenPBR -> Standard Surface
     "specular_roughness": "specular_roughness",
     "specular_ior": "specular_IOR",
     "specular_roughness_anisotropy": "specular_anisotropy",
+    "base_diffuse_roughness": "diffuse_roughness",
 }
+#: inputs written only where they differ from 0 (their default in both shading models)
+_ZERO_DEFAULT = ("base_diffuse_roughness",)
 
 
-def materialx_document(params: dict[str, Any], name: str = "brdfkit"):
-    """A MaterialX document with an open_pbr_surface and a standard_surface material; validated."""
+def materialx_document(params: dict[str, Any], name: str = "brdfkit", eon: bool = False):
+    """A MaterialX document with an open_pbr_surface and a standard_surface material; validated.
+
+    ``eon``: add a third material, ``oren_nayar_diffuse_bsdf`` (color = base_color, roughness =
+    base_diffuse_roughness, energy_compensation = true) in a ``surface`` shader: the EON model itself.
+    """
     import MaterialX as mx
 
     doc = mx.createDocument()
@@ -528,11 +563,21 @@ def materialx_document(params: dict[str, Any], name: str = "brdfkit"):
     opbr = doc.addNode("open_pbr_surface", f"SR_{safe}_openpbr", "surfaceshader")
     std = doc.addNode("standard_surface", f"SR_{safe}_standard", "surfaceshader")
     for k, v in params.items():
+        if k in _ZERO_DEFAULT and float(v) == 0.0:
+            continue
         put(opbr, k, v)
         if k in _SS_NAMES:
             put(std, _SS_NAMES[k], v)
     doc.addMaterialNode(f"M_{safe}_openpbr", opbr)
     doc.addMaterialNode(f"M_{safe}_standard", std)
+    if eon:
+        bsdf = doc.addNode("oren_nayar_diffuse_bsdf", f"BSDF_{safe}_eon", "BSDF")
+        put(bsdf, "color", params["base_color"])
+        put(bsdf, "roughness", params["base_diffuse_roughness"])
+        bsdf.setInputValue("energy_compensation", True)
+        surf = doc.addNode("surface", f"SR_{safe}_eon", "surfaceshader")
+        surf.setConnectedNode("bsdf", bsdf)
+        doc.addMaterialNode(f"M_{safe}_eon", surf)
     ok, msg = doc.validate()
     if not ok:  # pragma: no cover - our own document; a failure is a bug
         raise RuntimeError(f"MaterialX validation failed: {msg.strip()}")
@@ -549,10 +594,16 @@ def materialx_text(doc) -> str:
 
 # --------------------------------------------------------------------------- glTF
 def _gltf_direct(model: BRDF) -> tuple[dict[str, Any] | None, bool, str]:
-    p = getattr(model, "params", {})
+    p = model.params
     if _is(model, "lambert"):
         return {"base_color": _rgb(p["kd"]), "metallic": 0.0, "roughness": 1.0, "specular": 0.0}, True, (
             "lambert -> baseColor = kd, KHR_materials_specular.specularFactor = 0"
+        )
+    if _is_eon(model):
+        return {"base_color": _rgb(p["kd"]), "metallic": 0.0, "roughness": 1.0, "specular": 0.0,
+                "diffuse_roughness": eon_roughness(p)}, True, (
+            "oren-nayar eon -> baseColor = kd, specularFactor = 0, "
+            "KHR_materials_diffuse_roughness.diffuseRoughnessFactor = min(sigma, 1)"
         )
     if _is(model, "microfacet") and p["distribution"] == "ggx":
         ax, ay = float(p["alpha_x"]), float(p["alpha_y"])
@@ -631,6 +682,8 @@ def gltf_bytes(params: dict[str, Any], name: str = "brdfkit") -> bytes:
     sc = [float(x) for x in params["specular_color"]]
     if float(params["specular"]) != 1.0 or sc != [1.0, 1.0, 1.0]:
         ext["KHR_materials_specular"] = {"specularFactor": float(params["specular"]), "specularColorFactor": sc}
+    if float(params.get("diffuse_roughness", 0.0)) > 0:
+        ext["KHR_materials_diffuse_roughness"] = {"diffuseRoughnessFactor": float(params["diffuse_roughness"])}
     if ext:
         material.extensions = ext
     gl = g.GLTF2(
@@ -688,7 +741,7 @@ def export(model: BRDF, fmt: str, path: str | os.PathLike, *, metric: str = "nga
     if not isinstance(model, BRDF):
         raise ValueError(f"export: expected a model, got {type(model).__name__}")
     p = _check_path(path, fmt)
-    label = name or str(getattr(model, "label", None) or type(model).name or "material")
+    label = name or str(model.label or type(model).name or "material")
     if fmt == "mitsuba":
         d, info = mitsuba_dict(model, metric)
         text = _json_text(d) if p.suffix.lower() == ".json" else mitsuba_xml(d)
@@ -696,13 +749,15 @@ def export(model: BRDF, fmt: str, path: str | os.PathLike, *, metric: str = "nga
         target, params = _target_name(d), d
     elif fmt == "materialx":
         params, info = openpbr_params(model, metric)
-        doc = materialx_document(params, name=Path(label).stem)
+        eon = _is_eon(model)
+        doc = materialx_document(params, name=Path(label).stem, eon=eon)
         fileio.write_text(p, materialx_text(doc))
-        target = "open_pbr_surface (+ standard_surface)"
+        target = "open_pbr_surface (+ standard_surface" + (", oren_nayar_diffuse_bsdf)" if eon else ")")
     else:
         params, info = gltf_params(model, metric)
         fileio.write_bytes(p, gltf_bytes(params, name=Path(label).stem))
-        ext = [e for e in ("KHR_materials_ior", "KHR_materials_specular") if _gltf_uses(params, e)]
+        ext = [e for e in ("KHR_materials_ior", "KHR_materials_specular", "KHR_materials_diffuse_roughness")
+               if _gltf_uses(params, e)]
         target = "pbrMetallicRoughness" + "".join(f" + {e}" for e in ext)
     exact = bool(info["exact"])
     extra = {k: v for k, v in info.items() if k == "fit"}
@@ -716,6 +771,8 @@ def export(model: BRDF, fmt: str, path: str | os.PathLike, *, metric: str = "nga
 def _gltf_uses(params: dict[str, Any], ext: str) -> bool:
     if ext == "KHR_materials_ior":
         return float(params["ior"]) != 1.5
+    if ext == "KHR_materials_diffuse_roughness":
+        return float(params.get("diffuse_roughness", 0.0)) > 0
     return float(params["specular"]) != 1.0 or [float(x) for x in params["specular_color"]] != [1.0, 1.0, 1.0]
 
 

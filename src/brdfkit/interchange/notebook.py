@@ -1,6 +1,11 @@
 """How a model and a fit result show themselves in Jupyter.
 
-``BRDF._repr_png_`` / ``_repr_html_`` and ``FitResult._repr_html_`` delegate here.
+``BRDF._repr_png_`` / ``_repr_html_`` (:func:`model_png`, :func:`model_html`) and
+``FitResult._repr_html_`` (:func:`fit_html`) delegate here. The two model methods are attached
+to :class:`~brdfkit.models.base.BRDF` from outside, when :mod:`brdfkit` is imported (its
+``_attach_notebook_display``), so that ``brdfkit.models`` never imports this package; they
+import this module on the first display only, which keeps ``import brdfkit`` (and every CLI
+command that does not need it) free of ``brdfkit.interchange``.
 
 * a model: a PNG with a lit sphere (:func:`brdfkit.analysis.plots.sphere_image`,
   a directional light at 45° from the view axis, sRGB) and its 3D lobe for light
@@ -24,6 +29,9 @@ from typing import Any
 import numpy as np
 
 SPHERE_SIZE = 160
+#: background margin around the sphere inside its tile, as a fraction of the tile (each side):
+#: the disk would otherwise touch the tile's edges, the picture's left edge among them
+SPHERE_MARGIN = 0.05
 LIGHT_THETA_DEG = 45.0
 LIGHT_PHI_DEG = 135.0
 DPI = 72
@@ -74,13 +82,18 @@ def _hstack(images: list[np.ndarray], pad: int = 8) -> np.ndarray:
 
 
 def _sphere_rgb(model: Any, size: int = SPHERE_SIZE) -> np.ndarray:
+    """A ``size`` × ``size`` tile: the lit sphere, centred, on 0.15 grey with a margin of
+    :data:`SPHERE_MARGIN` on every side (the sphere's centre stays at pixel ``size // 2``)."""
     from ..analysis.plots import sphere_image
     from ..render.image import srgb_encode
 
-    img = sphere_image(model, LIGHT_THETA_DEG, LIGHT_PHI_DEG, size=size)
+    margin = max(2, int(round(SPHERE_MARGIN * size)))
+    img = sphere_image(model, LIGHT_THETA_DEG, LIGHT_PHI_DEG, size=size - 2 * margin)
     bg = ~np.isfinite(img[..., 0])
-    out = srgb_encode(np.clip(np.nan_to_num(img), 0, 1))
-    out[bg] = 0.15
+    disk = srgb_encode(np.clip(np.nan_to_num(img), 0, 1))
+    disk[bg] = 0.15
+    out = np.full((size, size, 3), 0.15)
+    out[margin : size - margin, margin : size - margin] = disk
     return (np.clip(out, 0, 1) * 255 + 0.5).astype(np.uint8)
 
 
@@ -120,9 +133,9 @@ def _img(png: bytes, alt: str) -> str:
 def model_html(model: Any) -> str:
     """HTML: the model's name, reference and parameters, and :func:`model_png`."""
     cls = type(model)
-    title = html.escape(f"{getattr(cls, 'name', cls.__name__)} — {getattr(cls, 'title', '')}".strip(" —"))
-    ref = html.escape(getattr(cls, "reference", "") or "")
-    params = getattr(model, "params", {}) or {}
+    title = html.escape(f"{cls.name or cls.__name__} — {cls.title}".strip(" —"))
+    ref = html.escape(cls.reference or "")
+    params = model.params or {}
     return (
         f"<div class='brdfkit-model'><b>{title}</b><br/><small>{ref}</small>"
         f"<div style='display:flex;gap:1em;align-items:flex-start'>{_table(params)}"

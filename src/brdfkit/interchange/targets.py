@@ -23,7 +23,11 @@ lecture); they follow the :class:`~brdfkit.models.base.BRDF` contract.
     with the GGX (Trowbridge-Reitz) ``D`` and the separable Smith ``G1`` of
     Appendix B (Walter et al. 2007 eqs. 33, 34). ``specular = 0`` leaves a pure
     Lambert ``base_color/π``; ``metallic = 1`` leaves the Schlick-Fresnel GGX
-    conductor with ``F0 = base_color``.
+    conductor with ``F0 = base_color``. With the draft ``KHR_materials_diffuse_roughness``
+    (``diffuse_roughness`` = its ``diffuseRoughnessFactor`` r > 0) the diffuse
+    ``base_color/π`` becomes the EON lobe of OpenPBR, ``f_EON(base_color, r)``
+    (:mod:`brdfkit.models.eon`: ``oren-nayar`` ``variant="eon"`` with ``sigma = r``).
+    Not fitted (held at its value, 0 unless a direct mapping sets it).
 
 :class:`OpenPBRSurface`
     The reflection of an opaque OpenPBR Surface (Academy Software Foundation,
@@ -41,7 +45,9 @@ lecture); they follow the :class:`~brdfkit.models.base.BRDF` contract.
                    f = specular_weight·specular_color·F_d · D G1 G1/(4 (n·l)(n·v))
                        + (1 − specular_weight·F_d) · base_weight·base_color/π
 
-    The specification layers the specular lobe over the diffuse base with
+    With ``base_diffuse_roughness`` r > 0 the diffuse ``base_weight·base_color/π`` is the
+    specification's EON lobe ``f_EON(base_weight·base_color, r)`` (:mod:`brdfkit.models.eon`;
+    not fitted, held at its value). The specification layers the specular lobe over the diffuse base with
     energy conservation whose exact form it leaves to the renderer; the
     (1 − specular_weight·F_d(v·h)) factor here is the simplest such coupling
     (that of glTF). The error an export reports is measured against this
@@ -57,6 +63,7 @@ import numpy as np
 
 from ..geometry import half_vector
 from ..models.base import BRDF
+from ..models.oren_nayar import OrenNayar
 from ..params import Param
 from ..terms.distributions import ggx
 from ..terms.fresnel import fresnel_dielectric_cook
@@ -75,6 +82,16 @@ def _ggx_lobe(wi, wo, ax, ay):
     G = smith_g1(wi, ax, ay, "ggx") * smith_g1(wo, ax, ay, "ggx")
     lobe = D * G / (dt(4) * np.maximum(wi[..., 2], dt(_COS_FLOOR)) * np.maximum(wo[..., 2], dt(_COS_FLOOR)))
     return np.minimum(lobe, np.finfo(wi.dtype).max / 4)[..., None], c[..., None]
+
+
+def _diffuse(albedo, roughness: float, wi, wo):
+    """The diffuse lobe: Lambert ``albedo/π`` at roughness 0 (exactly the former formula), else the
+    EON lobe of OpenPBR / KHR_materials_diffuse_roughness (``oren-nayar`` ``variant="eon"``, ``sigma = r``)."""
+    dt = wi.dtype.type
+    if roughness <= 0:
+        return albedo / dt(math.pi)
+    rgb = np.broadcast_to(np.asarray(albedo, dtype=np.float64), (3,))
+    return OrenNayar(kd=np.clip(rgb, 0.0, 1.0), sigma=float(roughness), variant="eon").eval(wi, wo)
 
 
 def _schlick5(c):
@@ -97,6 +114,8 @@ class GltfPBR(BRDF):
         Param("ior", "scalar", 1.5, (1.0, 5.0), doc="KHR_materials_ior.ior"),
         Param("specular", "scalar", 1.0, (0.0, 1.0), doc="KHR_materials_specular.specularFactor"),
         Param("specular_color", "rgb", (1.0, 1.0, 1.0), (0.0, 1.0), doc="KHR_materials_specular.specularColorFactor"),
+        Param("diffuse_roughness", "scalar", 0.0, (0.0, 1.0), doc="KHR_materials_diffuse_roughness.diffuseRoughnessFactor "
+              "(EON diffuse; 0 = Lambert)", fit=False),
     )
 
     def _eval(self, wi, wo, p):
@@ -109,7 +128,8 @@ class GltfPBR(BRDF):
         F0 = f0_d + (p["base_color"] - f0_d) * m
         F90 = p["specular"] + (1 - p["specular"]) * m
         F = F0 + (F90 - F0) * _schlick5(c)
-        return (1 - m) * (1 - F) * p["base_color"] / dt(math.pi) + F * lobe
+        diffuse = _diffuse(p["base_color"], float(p["diffuse_roughness"]), wi, wo)
+        return (1 - m) * (1 - F) * diffuse + F * lobe
 
 
 def f82_tint_fresnel(c, f0, tint):
@@ -148,6 +168,8 @@ class OpenPBRSurface(BRDF):
         Param("specular_roughness", "scalar", 0.3, (0.0, 1.0), fit_range=(0.03, 1.0)),
         Param("specular_roughness_anisotropy", "scalar", 0.0, (0.0, 1.0)),
         Param("specular_ior", "scalar", 1.5, (1.0, 5.0)),
+        Param("base_diffuse_roughness", "scalar", 0.0, (0.0, 1.0), doc="EON roughness of the diffuse base (0 = Lambert)",
+              fit=False),
     )
 
     def _eval(self, wi, wo, p):
@@ -159,7 +181,7 @@ class OpenPBRSurface(BRDF):
         base = p["base_weight"] * p["base_color"]
         metal = sw * f82_tint_fresnel(c, base, p["specular_color"]) * lobe
         Fd = fresnel_dielectric_cook(c, dt(p["specular_ior"]))
-        diel = sw * p["specular_color"] * Fd * lobe + (1 - sw * Fd) * base / dt(math.pi)
+        diel = sw * p["specular_color"] * Fd * lobe + (1 - sw * Fd) * _diffuse(base, float(p["base_diffuse_roughness"]), wi, wo)
         return m * metal + (1 - m) * diel
 
 

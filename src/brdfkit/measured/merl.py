@@ -368,15 +368,33 @@ class MERLBRDF(MeasuredBRDF):
 
 
 # --------------------------------------------------------------------------- tabulation
+#: (x, y) parameter pairs whose equality makes an anisotropic-class model isotropic in value
+_XY_PAIRS = (("alpha_x", "alpha_y"), ("nu", "nv")) + tuple((f"cx_{k}", f"cy_{k}") for k in (1, 2, 3))
+
+
+def _anisotropic_message(model: BRDF) -> str:
+    """save_merl's one-line refusal of an anisotropic model, saying what to give instead."""
+    name = getattr(model, "name", None) or type(model).__name__
+    params = getattr(model, "params", {}) or {}
+    spec = {q.name for q in getattr(type(model), "spec", ())}
+    head = f"{name}: the MERL format stores isotropic BRDFs only, and this {name} is anisotropic"
+    if "alpha" in spec:  # microfacet: one roughness makes the instance isotropic
+        return f"{head}; give one roughness, alpha=... (the isotropic parameter), instead of alpha_x and alpha_y"
+    pairs = [(x, y) for x, y in _XY_PAIRS if x in params and y in params]
+    equal = [f"{x} = {y}" for x, y in pairs if np.array_equal(np.asarray(params[x]), np.asarray(params[y]))]
+    if pairs and len(equal) == len(pairs):
+        return (f"{head} by class even with {', '.join(equal)} (it has no isotropic parameter); tabulate an "
+                "isotropic model instead, e.g. microfacet with alpha=... (its isotropic roughness), or "
+                "bk.fit an isotropic model to it first")
+    return f"{head}; tabulate an isotropic model (e.g. microfacet with alpha=..., its isotropic roughness)"
+
+
 def tabulate(model: BRDF, chunk: int = 6) -> np.ndarray:
     """Evaluate an isotropic model at every bin centre: ``(3, 90, 90, 180)``, −1 below the horizon."""
     if isinstance(model, MERLBRDF):
         return np.array(model.table)
     if not getattr(model, "isotropic", True):
-        raise ValueError(
-            f"{getattr(model, 'name', model)}: the MERL format stores isotropic BRDFs only; "
-            "give an isotropic model (e.g. equal alpha_x and alpha_y is still anisotropic by class)"
-        )
+        raise ValueError(_anisotropic_message(model))
     th, td, pd = bin_centres()
     out = np.empty((3,) + SHAPE)
     for i0 in range(0, RES_THETA_H, chunk):

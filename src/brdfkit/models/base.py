@@ -1,4 +1,4 @@
-"""The base class every BRDF model derives from.
+"""The base class every BRDF model derives from, and the hooks a model may define.
 
 A model subclass declares, as class attributes:
 
@@ -16,6 +16,17 @@ directions that are already known to lie strictly above the horizon
 working dtype (rgb parameters as ``(3,)`` arrays). :meth:`BRDF.eval` does the
 rest of the contract: broadcasting, dtype, the unit-direction check, the zero
 below the horizon.
+
+Every other hook is declared on :class:`BRDF` with its default, and documented there
+(who reads it, and when): ``kernel_float32``, ``kernel_span``, ``from_valid_is_init``,
+``fit_diff_step``, ``glsl_source``, ``source_path``, ``label``, ``source``, and the methods
+``kernel_args``, ``_setup``, ``active_params``, ``delta_reflectance``. A model overrides only
+what it needs; the readers find the default on the base class. ``docs/adding-a-model.md``
+walks through adding a model.
+
+Jupyter display (``_repr_png_``, ``_repr_html_``) is not defined here: models do not import
+:mod:`brdfkit.interchange`. Importing :mod:`brdfkit` attaches both to :class:`BRDF`; the work
+lives in :mod:`brdfkit.interchange.notebook`.
 """
 
 from __future__ import annotations
@@ -35,10 +46,46 @@ class BRDF:
     reference: ClassVar[str] = ""
     isotropic: ClassVar[bool] = True
     spec: ClassVar[tuple[Param, ...]] = ()
-    #: the compiled scalar kernel (protocol: :mod:`brdfkit.engine`); None: ``_eval`` is used
+    # -- hooks: declared here with their defaults; a model overrides what it needs ---------
+    #: The compiled scalar kernel (protocol: :mod:`brdfkit.engine`), as ``staticmethod(fn)``.
+    #: Read by :func:`brdfkit.engine.evaluate.evaluate` on every ``eval`` (None: ``_eval`` runs),
+    #: by the fitter's prepared evaluation (:mod:`brdfkit.measured.fit`) and the engine tests.
     kernel: ClassVar[Any] = None
-    #: float32 input runs the kernel's float32 twin (brdfkit.engine.precision); False: computed in float64
+    #: Whether float32 input runs the kernel's float32 twin (:mod:`brdfkit.engine.precision`).
+    #: Read by the engine on every float32 ``eval``; False: the kernel computes in float64 and the
+    #: result is rounded (measured tables, HTSG, Ashikhmin-Shirley).
     kernel_float32: ClassVar[bool] = True
+    #: The same kernel over a span of pairs, ``staticmethod(fn)``, for a kernel whose inner loop
+    #: the compiled driver should run in the model's own order (HTSG's series). Read by
+    #: :func:`brdfkit.engine.evaluate.evaluate` and passed to the driver; None: pair by pair.
+    kernel_span: ClassVar[Any] = None
+    #: True when ``_from_valid`` may build the model although the class defines its own
+    #: ``__init__`` (that ``__init__`` only prepares the values for validation; ``_init_valid``
+    #: derives the rest). Read by the fitter's prepared evaluation (:mod:`brdfkit.measured.fit`)
+    #: when it builds one model per step; it looks at the class's own ``vars``, so declare it
+    #: beside that ``__init__`` (microfacet does).
+    from_valid_is_init: ClassVar[bool] = False
+    #: Relative finite-difference step the fitter uses for this model's Jacobian, or None for
+    #: scipy's default (sqrt of machine epsilon). Read by :func:`brdfkit.measured.fit.fit` when it
+    #: sets up least squares. A model whose values move in float32 steps (a ``.brdf`` shader
+    #: evaluated through GL uniforms) needs a larger one (1e-3).
+    fit_diff_step: ClassVar[float | None] = None
+    #: GLSL source the model carries itself (defines ``vec3 brdf(vec3 wi, vec3 wo)``), instead of
+    #: ``render/shaders/<module>.glsl``. Read by :mod:`brdfkit.render.glsl` (shader_path,
+    #: has_shader, shader_source) whenever the model is rendered or its shader compiled; "" for
+    #: the built-in models (their shader file is found from the module name).
+    glsl_source: ClassVar[str] = ""
+    #: Where a carried ``glsl_source`` came from (a ``.brdf`` file's path); read by
+    #: :func:`brdfkit.render.glsl.shader_path` to name the shader in messages and caches.
+    source_path: ClassVar[str] = ""
+    #: A display name that replaces ``name`` in reports, plots, fits and exports (measured data:
+    #: ``"merl/gold-metallic-paint"``, a MERL file's stem). Usually set per instance; read by
+    #: ``brdfkit eval``/``info``, :mod:`brdfkit.analysis` (plot labels, check reports), the fitter
+    #: and :func:`brdfkit.export`. None: ``name`` is shown.
+    label: ClassVar[str | None] = None
+    #: Where the model's data came from (a MERL file's path), set per instance by loaders; read by
+    #: ``brdfkit info``. "" for analytic models.
+    source: ClassVar[str] = ""
 
     def __init__(self, **params: Any) -> None:
         self._init_valid(validate(self.name, self.spec, params))
@@ -61,7 +108,8 @@ class BRDF:
         self._setup()
 
     def _setup(self) -> None:
-        """Hook for derived quantities (called after validation)."""
+        """Hook for derived quantities: called by ``_init_valid`` once the parameters are validated
+        (construction, ``with_params``, the fitter's ``_from_valid``). Does nothing by default."""
 
     # -- the contract --------------------------------------------------------
     def eval(self, wi, wo) -> np.ndarray:
@@ -83,7 +131,9 @@ class BRDF:
         """``(p, c)`` for :attr:`kernel`: float64 numeric and int64 choice arrays (see :mod:`brdfkit.engine`).
 
         Returning ``None`` makes this instance use ``_eval`` instead (for an option
-        the kernel does not implement yet).
+        the kernel does not implement yet). Called by :func:`brdfkit.engine.evaluate.evaluate` on
+        every ``eval`` of a model with a ``kernel`` and by the fitter's prepared evaluation; build the
+        arrays with :meth:`_pack` (cached per instance).
         """
         raise NotImplementedError(f"{self.name}: a model with a kernel must implement kernel_args()")
 
@@ -117,7 +167,8 @@ class BRDF:
 
         All of them by default; a model whose options switch parameters off
         (``microfacet``'s Fresnel choice, say) leaves those out. ``params`` stays
-        the complete, effective set.
+        the complete, effective set. Called by :func:`brdfkit.analysis.plots.label` (legends,
+        titles) when a model is plotted or rendered with a caption.
         """
         return dict(self.params)
 
@@ -126,7 +177,8 @@ class BRDF:
 
         That light leaves along ``reflect(w)``; ``eval`` cannot return a delta, so
         albedo and energy checks add this term. Zero for models without one (all
-        but ``htsg`` and ``schlick``).
+        but ``htsg`` and ``schlick``). Called by :func:`brdfkit.analysis.albedo.albedo_result`
+        (``brdfkit check``, the energy tests) for every albedo it computes.
         """
         w = np.asarray(w)
         return np.zeros(w.shape[:-1] + (3,), dtype=np.float32 if w.dtype == np.float32 else np.float64)
@@ -174,14 +226,3 @@ class BRDF:
     def __repr__(self) -> str:
         args = ", ".join(f"{k}={v!r}" if not isinstance(v, np.ndarray) else f"{k}={v.tolist()}" for k, v in self.params.items())
         return f"bk.model({self.name!r}, {args})"
-
-    # -- notebook display (the work lives in brdfkit.interchange.notebook) -------------
-    def _repr_png_(self) -> bytes:
-        from ..interchange.notebook import model_png
-
-        return model_png(self)
-
-    def _repr_html_(self) -> str:
-        from ..interchange.notebook import model_html
-
-        return model_html(self)

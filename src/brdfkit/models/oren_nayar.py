@@ -1,4 +1,4 @@
-"""Oren-Nayar: rough diffuse reflection from V-cavities of Lambertian facets.
+"""Oren-Nayar: rough diffuse reflection from V-cavities of Lambertian facets, and its energy-preserving EON form.
 
 Reference: M. Oren and S. K. Nayar, "Generalization of Lambert's Reflectance
 Model", SIGGRAPH 1994, pp. 239-246 — the functional approximation of the
@@ -44,9 +44,33 @@ variant="full" (the paper's model with interreflections):
          0.45 σ²/(σ² + 0.09) · (sin α − (2β/π)³)        otherwise
     C3 = 0.125 σ²/(σ² + 0.09) · (4αβ/π²)²
 
-σ = 0 gives A = C1 = 1 and B = C2 = C3 = f2 = 0: exactly Lambert, kd/π.
+variant="eon" (Portsmouth, Kutz & Hill, "EON: A Practical Energy-Preserving
+Rough Diffuse BRDF", JCGT 14(1), 2025; the formulas and their numerics are in
+:mod:`brdfkit.models.eon`):
 
-Both variants are symmetric in (wi, wo) (α, β and |Δφ| are), hence
+    f_r = (ρ/π) A (1 + r s/t) + (ρ_ms/π) (1 − E(μi)) (1 − E(μo)) / (1 − Ē)
+    A = 1/(1 + (1/2 − 2/(3π)) r),  s = wi·wo − μi μo,  t = max(μi, μo) if s > 0 else 1
+    E = the closed-form albedo of the first term (ρ = 1), Ē its mean,
+    ρ_ms = ρ² Ē/(1 − ρ(1 − Ē)),     r = min(σ, 1)
+
+    The roughness r ∈ [0, 1] of EON is taken from ``sigma`` as r = min(σ, 1): σ
+    itself, as Fujii's FON form (EON's first term) uses the Oren-Nayar σ to match
+    the full 1994 model, and as MaterialX 1.39's ``oren_nayar_diffuse_bsdf`` feeds one
+    ``roughness`` input both to its qualitative model (as σ) and to its EON (as r).
+    EON is defined for r ≤ 1 only (its first term would turn negative beyond), so
+    every σ in [1, π/2) gives the EON of r = 1. The exports write r as OpenPBR's
+    ``base_diffuse_roughness``, MaterialX's ``roughness`` and glTF's
+    ``diffuseRoughnessFactor``.
+
+    Unlike the two 1994 variants it conserves energy exactly and loses none: for
+    kd = 1 the directional albedo is 1 at every angle (up to the horizon), and for
+    any kd it is kd E(μ) + ρ_ms (1 − E(μ)) in closed form. Reciprocal (symmetric in
+    wi, wo). Its multiple-scattering term is not linear in kd (ρ_ms is not).
+
+σ = 0 gives A = C1 = 1 and B = C2 = C3 = f2 = 0: exactly Lambert, kd/π (and so does
+variant="eon": r = 0).
+
+The two 1994 variants are symmetric in (wi, wo) (α, β and |Δφ| are), hence
 reciprocal. Neither is exactly energy conserving: they are fits to a
 V-cavity model, and tan β grows without bound when both directions approach
 the horizon. Measured directional albedo with kd = 1: qualitative σ = 0.1
@@ -74,7 +98,9 @@ parameter  kind    default      range                  meaning
 =========  ======  ===========  =====================  ==================================
 kd         rgb     0.8          [0, 1]                 facet albedo ρ (σ = 0: kd/π)
 sigma      scalar  0.3          [0, π/2)  rad          std. dev. of the facet slope angle
-variant    choice  qualitative  qualitative | full     the A,B model or the full model
+                                                       (eon: its roughness r = min(σ, 1))
+variant    choice  qualitative  qualitative | full     the A,B model, the full model or
+                                | eon                  the energy-preserving EON (2025)
 =========  ======  ===========  =====================  ==================================
 """
 
@@ -89,6 +115,7 @@ from ..geometry import hypot_c
 from ..params import Param, kd_param
 from ..registry import register
 from .base import BRDF
+from .eon import eon_avg_albedo, eon_channel, eon_ms_shape, fon_g, fon_single
 
 #: floor on cos β and on cos α + cos β (keeps tan β and tan((α+β)/2) finite)
 COS_FLOOR = 1e-6
@@ -137,11 +164,34 @@ def oren_nayar_interreflection(sig2, cos_dphi, beta):
 
 
 @jit
+def eon_roughness(sigma):
+    """EON's roughness r ∈ [0, 1] from the Oren-Nayar σ: r = min(σ, 1) (see the module docstring)."""
+    return min(sigma, 1.0)
+
+
+@jit
+def eon(wix, wiy, wiz, wox, woy, woz, si, ti, so, to, p):
+    """f_EON (Portsmouth, Kutz & Hill 2025; :mod:`brdfkit.models.eon`), RGB, ``p = [kd(3), sigma]``."""
+    r = eon_roughness(p[3])
+    s = wix * wox + wiy * woy  # wi·wo − μi μo, without the cancellation
+    single = fon_single(r, s, wiz, woz)
+    shape = eon_ms_shape(r, fon_g(si, wiz, ti), fon_g(so, woz, to))
+    e_avg = eon_avg_albedo(r)
+    return (
+        eon_channel(p[0], single, shape, e_avg),
+        eon_channel(p[1], single, shape, e_avg),
+        eon_channel(p[2], single, shape, e_avg),
+    )
+
+
+@jit
 def oren_nayar_kernel(wix, wiy, wiz, wox, woy, woz, p, c):
-    """Oren & Nayar (1994): ``p = [kd(3), sigma]``, ``c = [variant]`` (0 qualitative, 1 full)."""
+    """Oren & Nayar (1994) and EON (2025): ``p = [kd(3), sigma]``, ``c = [variant]`` (0 qualitative, 1 full, 2 eon)."""
     sig2 = p[3] * p[3]
     si, ci, ti, cpi, spi = polar_angles(wix, wiy, wiz)
     so, co, to, cpo, spo = polar_angles(wox, woy, woz)
+    if c[0] == 2:
+        return eon(wix, wiy, wiz, wox, woy, woz, si, ti, so, to, p)
     cos_dphi = min(max(cpi * cpo + spi * spo, -1.0), 1.0)
     sin_a = max(si, so)  # α = max(θi, θo): the larger sine, the smaller cosine
     cos_a = min(ci, co)
@@ -165,8 +215,11 @@ def oren_nayar_kernel(wix, wiy, wiz, wox, woy, woz, p, c):
 @register
 class OrenNayar(BRDF):
     name = "oren-nayar"
-    title = "Oren-Nayar rough diffuse (qualitative A,B model or the full 1994 model)"
-    reference = "Oren and Nayar, Generalization of Lambert's Reflectance Model, SIGGRAPH 1994"
+    title = "Oren-Nayar rough diffuse (qualitative A,B model, the full 1994 model, or the energy-preserving EON)"
+    reference = (
+        "Oren and Nayar, Generalization of Lambert's Reflectance Model, SIGGRAPH 1994; "
+        "Portsmouth, Kutz and Hill, EON: A Practical Energy-Preserving Rough Diffuse BRDF, JCGT 14(1), 2025"
+    )
     isotropic = True
     spec = (
         kd_param(0.8, "facet albedo ρ (σ = 0 gives Lambert kd/π)"),
@@ -176,15 +229,16 @@ class OrenNayar(BRDF):
             0.3,
             (0.0, float(np.pi / 2)),
             "rad",
-            "standard deviation σ of the facet slope angle (0 = Lambert)",
+            "standard deviation σ of the facet slope angle (0 = Lambert); eon: roughness r = min(σ, 1)",
             open_hi=True,
         ),
         Param(
             "variant",
             "choice",
             "qualitative",
-            doc="qualitative: the lecture's A, B formula; full: C1, C2, C3 and the interreflection term",
-            choices=("qualitative", "full"),
+            doc="qualitative: the lecture's A, B formula; full: C1, C2, C3 and the interreflection term; "
+            "eon: the energy-preserving Oren-Nayar of Portsmouth, Kutz & Hill 2025 (OpenPBR's diffuse)",
+            choices=("qualitative", "full", "eon"),
             fit=False,
         ),
     )

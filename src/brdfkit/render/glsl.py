@@ -138,15 +138,15 @@ def shader_path(model_or_name: Any) -> Path:
     cls = _model_class(model_or_name)
     if is_measured(cls):
         return SHADER_DIR / "measured.glsl"
-    if getattr(cls, "glsl_source", ""):  # a model that carries its own GLSL (a .brdf file)
-        return Path(getattr(cls, "source_path", "") or cls.name)
+    if cls.glsl_source:  # a model that carries its own GLSL (a .brdf file); hook declared on BRDF
+        return Path(cls.source_path or cls.name)
     module = cls.__module__.rsplit(".", 1)[-1]
     return SHADER_DIR / f"{module}.glsl"
 
 
 def has_shader(model_or_name: Any) -> bool:
     """Whether the model has a GLSL file (or carries its own source, ``glsl_source``)."""
-    if getattr(_model_class(model_or_name), "glsl_source", ""):
+    if _model_class(model_or_name).glsl_source:
         return True
     return shader_path(model_or_name).is_file()
 
@@ -177,7 +177,7 @@ def shader_source(model_or_name: Any) -> str:
     uniforms. ``ValueError`` if the model has no GLSL file.
     """
     cls = _model_class(model_or_name)
-    own = getattr(cls, "glsl_source", "")
+    own = cls.glsl_source
     if own:  # foreign GLSL wrapped in our convention (brdfkit.interchange.brdf_explorer)
         return common_source() + f"\n// ---- {cls.name} ----\n" + own
     path = shader_path(cls)
