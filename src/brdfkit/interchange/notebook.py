@@ -144,18 +144,18 @@ def model_html(model: Any) -> str:
 
 
 def _measured_for(result: Any):
-    """The fit's measured source as a model, if it can be found again (a material name or MERL path)."""
+    """The fit's measured source as a model, if it can be found again (a material name or a file)."""
     try:
-        from ..measured.fit import resolve_source
+        from ..sources import resolve
 
-        return resolve_source(result.source)
+        return resolve(result.source)
     except Exception:  # noqa: BLE001 - the report shows the fitted side alone then
         return None
 
 
 def fit_html(result: Any) -> str:
     """HTML report of a :class:`brdfkit.measured.fit.FitResult`."""
-    from ..measured.fit import METRIC_TITLES
+    from ..measured.metrics import METRIC_TITLES
     from ..measured.report import shade_sphere
     from ..render.image import srgb_encode
 
