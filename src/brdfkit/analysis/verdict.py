@@ -219,6 +219,7 @@ STRESS: dict[str, list[dict[str, Any]]] = {
     "oren-nayar": [
         {"kd": 1.0, "sigma": 1.0, "variant": "qualitative"},
         {"kd": 1.0, "sigma": 1.0, "variant": "full"},
+        {"kd": 1.0, "sigma": 1.0, "variant": "eon"},  # white furnace: conserves energy where the two above do not
     ],
     "ward": [
         {"kd": 0.0, "ks": 1.0, "alpha_x": 0.5, "alpha_y": 0.5, "normalization": "ward"},
