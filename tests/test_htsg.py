@@ -526,7 +526,7 @@ def test_model_module_keeps_the_series_names():
     """The series and its special functions live in brdfkit.terms; the model module still offers its
     public names (the same objects, not copies), and the kernels it composes are theirs."""
     for name in ("htsg_series", "htsg_log_series_ratio", "asymptotic_coefficients", "ASYMPTOTIC_G",
-                 "ASYMPTOTIC_ORDER"):
+                 "ASYMPTOTIC_ORDER", "ASYMPTOTIC_A_SCALE", "ASYMPTOTIC_A_POWER"):
         assert getattr(H, name) is getattr(K, name), name
     assert H.lambertw_from_log is S.lambertw_from_log
     assert H.log_series_ratio is K.log_series_ratio and H.span_terms is K.span_terms

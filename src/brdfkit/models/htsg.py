@@ -143,6 +143,8 @@ from ..params import Param
 from ..registry import register
 from ..terms.fresnel import f_conductor, fresnel_conductor
 from ..terms.htsg_series import (
+    ASYMPTOTIC_A_POWER,
+    ASYMPTOTIC_A_SCALE,
     ASYMPTOTIC_G,
     ASYMPTOTIC_ORDER,
     SORT_BINS,
@@ -520,4 +522,6 @@ __all__ = [
     "z0_ratio_squared",
     "ASYMPTOTIC_G",
     "ASYMPTOTIC_ORDER",
+    "ASYMPTOTIC_A_SCALE",
+    "ASYMPTOTIC_A_POWER",
 ]
