@@ -23,6 +23,8 @@ from brdfkit.geometry import spherical_to_vector
 from brdfkit.terms.fresnel import fresnel_conductor
 
 H = importlib.import_module("brdfkit.models.htsg")
+K = importlib.import_module("brdfkit.terms.htsg_series")  # the series Σ(g, T)
+S = importlib.import_module("brdfkit.terms.special")  # Lambert W, ln m!, Stirling, Loader's deviance
 
 
 # ---------------------------------------------------------------------------- series
@@ -78,12 +80,12 @@ def test_thinned_direct_sum_matches_long_sum():
     rng = np.random.default_rng(7)
     g = np.concatenate([10 ** rng.uniform(1, 4.3, 300), rng.uniform(10, 50, 300)])
     T = np.where(rng.random(600) < 0.2, 0.0, g * 10 ** rng.uniform(-4, 1.5, 600))
-    lw = np.where(T > 0, H.lambertw_from_log(np.log(np.maximum(2 * T, 1e-300)) - 2 * np.log(g)), 0.0)
+    lw = np.where(T > 0, S.lambertw_from_log(np.log(np.maximum(2 * T, 1e-300)) - 2 * np.log(g)), 0.0)
     mstar = np.maximum(g * np.exp(0.5 * lw), 1.0)
     var = 1 / (1 / mstar + 2 * T / mstar**3)
-    steps = np.array([H.thinning_step(v, -40.0) for v in var])
+    steps = np.array([K.thinning_step(v, -40.0) for v in var])
     assert (steps > 1).mean() > 0.5 and steps.max() > 20  # the test exercises the thinning
-    got = H._direct_log_ratio(g, T)
+    got = K._direct_log_ratio(g, T)
     ref = np.array([_long_sum_log_ratio(a, b) for a, b in zip(g, T)])
     rel = np.abs(np.expm1(got - ref))
     assert rel.max() < 1e-8, (g[rel.argmax()], T[rel.argmax()], rel.max())
@@ -102,16 +104,16 @@ def test_series_matches_mpmath(g, T):
 
 def test_both_tiers_agree_where_asymptotic_form_is_used():
     g = np.repeat([40.0, 55.0, 120.0, 800.0, 5e3, 5e4], 12)
-    amax = H.ASYMPTOTIC_A_SCALE * g**H.ASYMPTOTIC_A_POWER
+    amax = K.ASYMPTOTIC_A_SCALE * g**K.ASYMPTOTIC_A_POWER
     a = amax * np.tile(np.linspace(0, 1, 12), 6)
-    asym = H._asymptotic_log_ratio(g, a * g)
-    direct = H._direct_log_ratio(g, a * g)
+    asym = K._asymptotic_log_ratio(g, a * g)
+    direct = K._direct_log_ratio(g, a * g)
     assert np.max(np.abs(np.expm1(asym - direct))) < 1e-6
 
 
 def test_asymptotic_first_order_coefficient():
     # order 1/g: ∫ e^-s (s²/2) J0(2√(as)) ds = L_2(a) e^-a, L_2(a) = (a² − 4a + 2)/2
-    Q = H.asymptotic_coefficients(3)
+    Q = K.asymptotic_coefficients(3)
     assert [float(c) for c in Q[1]] == [1.0, -2.0, 0.5]
     assert all(float(c) == 0 for c in Q[0])
     assert len(Q[3]) == 5  # Q_n has degree n + 1
@@ -127,11 +129,11 @@ def test_series_small_g_limit_and_zero():
 def test_lambertw_matches_scipy():
     lz = np.concatenate([np.linspace(-720, 700, 50001), [-np.inf]])
     ref = np.where(np.isfinite(lz), lambertw(np.exp(lz)).real, 0.0)
-    got = H.lambertw_from_log(lz)
+    got = S.lambertw_from_log(lz)
     assert np.all(np.abs(got - ref) <= 1e-13 * np.maximum(ref, 1e-300))
     # huge arguments, where exp(lz) overflows: w + ln w = lz
     lz = np.array([1e3, 1e6, 1e300])
-    w = H.lambertw_from_log(lz)
+    w = S.lambertw_from_log(lz)
     np.testing.assert_allclose(w + np.log(w), lz, rtol=1e-14)
 
 
@@ -370,22 +372,22 @@ def test_series_windows_fit_the_table_and_the_span_cap_over_the_parameter_range(
     most, last = 0.0, 0.0
     for g in np.concatenate([np.geomspace(1e-4, 40, 120), np.geomspace(40, 2e4, 120)]):
         for T in np.concatenate([[0.0], np.geomspace(1e-4, 1e8, 120)]):
-            if H.asymptotic_tier(g, T):
+            if K.asymptotic_tier(g, T):
                 continue
-            mc, h, jlo, jhi, peak = H.direct_window(g, T, np.log(g))
+            mc, h, jlo, jhi, peak = K.direct_window(g, T, np.log(g))
             most = max(most, jhi - jlo + 1)
             last = max(last, mc + jhi * h)
-    assert 60 <= most <= 86 < H.WINDOW_CAP
-    assert last < H.LN_TABLE_SIZE
+    assert 60 <= most <= 86 < K.WINDOW_CAP
+    assert last < S.LN_TABLE_SIZE
 
 
 def test_stirling_series_continues_the_table():
-    m = np.array([H.LN_TABLE_SIZE - 2.0, H.LN_TABLE_SIZE - 1.0, 1e5, 1e7])
+    m = np.array([S.LN_TABLE_SIZE - 2.0, S.LN_TABLE_SIZE - 1.0, 1e5, 1e7])
     want = gammaln(m + 1) + np.log(m)
-    got = np.array([H.stirling_ln_fact_times_m(x) for x in m])
+    got = np.array([S.stirling_ln_fact_times_m(x) for x in m])
     np.testing.assert_allclose(got, want, rtol=1e-15)
-    assert H.ln_fact_times_m(H.LN_TABLE_SIZE - 1.0) == H._LN_FACT_M[-1]
-    assert H.ln_fact_times_m(1e5) == H.stirling_ln_fact_times_m(1e5)
+    assert S.ln_fact_times_m(S.LN_TABLE_SIZE - 1.0) == S.LN_FACT_TIMES_M[-1]
+    assert S.ln_fact_times_m(1e5) == S.stirling_ln_fact_times_m(1e5)
 
 
 def _mp_log_term(m, g, T):
@@ -404,10 +406,10 @@ def test_poisson_deviance_matches_mpmath_on_both_sides_of_its_switch():
     with mpmath.workdps(50):
         for mi, gi in zip(m, g):
             want = mpmath.mpf(mi) * mpmath.log(mpmath.mpf(mi) / mpmath.mpf(gi)) + mpmath.mpf(gi) - mpmath.mpf(mi)
-            got = H.poisson_deviance(mi, gi)
+            got = S.poisson_deviance(mi, gi)
             worst = max(worst, abs(got - float(want)) / max(float(want), 1e-300))
     vv = (m - g) / (m + g)
-    assert (np.abs(vv) < H.DEVIANCE_SERIES).sum() > 500 and (np.abs(vv) >= H.DEVIANCE_SERIES).sum() > 500
+    assert (np.abs(vv) < S.DEVIANCE_SERIES).sum() > 500 and (np.abs(vv) >= S.DEVIANCE_SERIES).sum() > 500
     assert worst < 5e-14
 
 
@@ -416,7 +418,7 @@ def test_stirling_remainder_matches_mpmath_below_and_above_the_table():
         with mpmath.workdps(50):
             mm = mpmath.mpf(m)
             want = mpmath.loggamma(mm + 1) - (mm + mpmath.mpf(0.5)) * mpmath.log(mm) + mm - mpmath.log(2 * mpmath.pi) / 2
-        assert abs(H.stirling_remainder(float(m)) - float(want)) <= 2e-16 * max(float(want), 1e-3), m
+        assert abs(S.stirling_remainder(float(m)) - float(want)) <= 2e-16 * max(float(want), 1e-3), m
 
 
 def test_peak_term_has_no_cancellation_and_does_not_amplify_an_error_in_ln_g():
@@ -432,10 +434,10 @@ def test_peak_term_has_no_cancellation_and_does_not_amplify_an_error_in_ln_g():
         T = g * 10 ** rng.uniform(-3, 2) if rng.random() < 0.8 else 0.0
         m = max(round(g * 10 ** rng.uniform(-0.05, 0.3)), 1)
         lg = np.log(g)
-        got = H.log_term(float(m), lg, g, T)
+        got = K.log_term(float(m), lg, g, T)
         want = float(_mp_log_term(m, g, T))
         worst = max(worst, abs(got - want) / (1.0 + abs(want) / 10.0))  # + 2e-15 of the value itself
-        moved = H.log_term(float(m), lg * (1 + 4 * 2.0**-52), g, T) - got
+        moved = K.log_term(float(m), lg * (1 + 4 * 2.0**-52), g, T) - got
         assert abs(moved) <= 4 * 2.0**-52 * abs(lg) + 4 * 2.0**-52 * max(abs(lg), abs(got), 1.0)  # + the roundings
     assert worst < 2e-14
 
@@ -451,17 +453,17 @@ def test_span_terms_sum_each_window_whatever_the_order_of_the_pairs():
         T = g * 10 ** rng.uniform(-2, 1, nb)
         LG, TT, BASE, Hs, CNT, MC, LFC = (np.zeros(nb) for _ in range(7))
         for i in range(nb):
-            mc, h, jlo, jhi, peak = H.direct_window(g[i], T[i], np.log(g[i]))
+            mc, h, jlo, jhi, peak = K.direct_window(g[i], T[i], np.log(g[i]))
             LG[i], TT[i], BASE[i], Hs[i], MC[i] = np.log(g[i]), T[i], mc + jlo * h, h, mc
-            CNT[i], LFC[i] = jhi - jlo + 1, H.ln_fact_times_m(mc)
+            CNT[i], LFC[i] = jhi - jlo + 1, S.ln_fact_times_m(mc)
         CNT[:3] = [200.0, 150.0, 0.0]  # past SORT_BINS, and an empty window
         BASE[:2] = np.maximum(MC[:2] - 20 * Hs[:2], 1.0)
         ACC = np.zeros(nb)
-        H.span_terms(LG, TT, BASE, Hs, CNT, MC, LFC, ACC, m, np.empty((8, nb)), np.empty(nb, np.int64),
-                     np.empty(H.SORT_BINS, np.int64))
+        K.span_terms(LG, TT, BASE, Hs, CNT, MC, LFC, ACC, m, np.empty((8, nb)), np.empty(nb, np.int64),
+                     np.empty(K.SORT_BINS, np.int64))
         for i in range(nb):
             mm = BASE[i] + Hs[i] * np.arange(CNT[i] if i < m else 0)
-            lf = np.array([H.ln_fact_times_m(x) for x in mm])
+            lf = np.array([S.ln_fact_times_m(x) for x in mm])
             want = np.exp((mm - MC[i]) * (LG[i] + TT[i] / (mm * MC[i])) - (lf - LFC[i])).sum()
             assert ACC[i] == pytest.approx(want, rel=1e-13, abs=0.0)
 
@@ -518,3 +520,15 @@ def test_small_calls_run_the_per_pair_kernel_with_the_spans_values():
     assert nz.sum() > 500
     np.testing.assert_allclose(small[nz], big[nz], rtol=1e-12, atol=0)
     np.testing.assert_allclose(one, big[7], rtol=1e-12, atol=0)
+
+
+def test_model_module_keeps_the_series_names():
+    """The series and its special functions live in brdfkit.terms; the model module still offers its
+    public names (the same objects, not copies), and the kernels it composes are theirs."""
+    for name in ("htsg_series", "htsg_log_series_ratio", "asymptotic_coefficients", "ASYMPTOTIC_G",
+                 "ASYMPTOTIC_ORDER", "ASYMPTOTIC_A_SCALE", "ASYMPTOTIC_A_POWER"):
+        assert getattr(H, name) is getattr(K, name), name
+    assert H.lambertw_from_log is S.lambertw_from_log
+    assert H.log_series_ratio is K.log_series_ratio and H.span_terms is K.span_terms
+    assert K.ln_fact_times_m is S.ln_fact_times_m and K.LN_FACT_TIMES_M is S.LN_FACT_TIMES_M
+    assert set(H.__all__) <= set(dir(H))

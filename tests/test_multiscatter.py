@@ -108,7 +108,7 @@ def test_tables_reproduce_from_the_quadrature():
     al = ms.alpha_grid()
     for d, s, k in (("ggx", "smith", 32), ("beckmann", "smith-correlated", 13), ("ggx", "v-groove", 7)):
         m = bk.model("microfacet", distribution=d, shadowing=s, alpha=float(al[k]), fresnel="none")
-        e = albedo(m, np.arccos(mu[::4]), level="fine")[:, 0]  # as build_tables
+        e = albedo(m, np.arccos(mu[::4]), level="fine")[:, 0]  # as analysis.multiscatter_tables
         np.testing.assert_allclose(ms.table(d, s)[k, ::4], e, atol=2e-6)
     assert np.all(ms.table("ggx", "smith")[0] == 1.0)
     t = ms.table("ggx", "smith")[:, mu >= math.cos(math.radians(80))]
@@ -148,10 +148,45 @@ def test_bad_input_is_a_value_error():
 
 
 def test_glsl_tables_are_the_shipped_tables():
-    """shaders/microfacet.glsl carries the tables as constants; they must be the current .npz (regenerate
-    with brdfkit.terms.multiscatter.write_glsl_tables())."""
+    """shaders/multiscatter_tables.glsl (included by microfacet.glsl) carries the tables as constants; they must
+    be the current .npz (regenerate with ``python -m brdfkit.render.generate``)."""
     from brdfkit.render import glsl
 
-    text = glsl.shader_path("microfacet").read_text(encoding="utf-8")
-    i, j = text.index(ms.GLSL_BEGIN), text.index(ms.GLSL_END)
-    assert text[i:text.index("\n", j) + 1] == ms.glsl_tables()
+    text = glsl.shader_file("multiscatter_tables.glsl")
+    assert text.endswith(ms.glsl_tables())
+    assert text.count("const vec4 BK_MS_MISSING4[") == 1
+    assert glsl.shader_source("microfacet").count(ms.glsl_tables()) == 1
+
+
+def test_build_tables_writes_what_the_term_reads(tmp_path, monkeypatch):
+    """The table builder (brdfkit.analysis.multiscatter_tables) with a stand-in quadrature: every table, on the
+    term's grids, the mirror row 1, written atomically to the path given; the term then reads such a file."""
+    from brdfkit.analysis import multiscatter_tables as mt
+
+    calls = []
+
+    def fake_albedo(m, theta, level):
+        calls.append((m.params["distribution"], m.params["shadowing"], m.params["alpha_x"], level))
+        assert m.params["fresnel"] == "none" and np.all(np.asarray(m.params["kd"]) == 0)
+        return np.cos(theta)[:, None] * np.array([1.0, 1.0, 1.0]) * (1.0 - 0.5 * m.params["alpha_x"])
+
+    monkeypatch.setattr(mt, "albedo", fake_albedo)
+    path = tmp_path / "sub" / "ms.npz"
+    out = mt.build_tables(path, level="coarse")
+    assert len(calls) == len(ms.DISTRIBUTIONS) * len(ms.SHADOWINGS) * (ms.N_ALPHA - 1)
+    assert {c[3] for c in calls} == {"coarse"}
+    with np.load(path) as z:
+        assert sorted(z.files) == sorted(out)
+        np.testing.assert_array_equal(z["mu"], ms.mu_grid())
+        t = z[ms.table_key("ggx", "v-groove")]
+    assert t.shape == (ms.N_ALPHA, ms.N_MU) and np.all(t[0] == 1.0)
+    np.testing.assert_allclose(t[-1], 0.5 * ms.mu_grid(), rtol=1e-12)  # cos(arccos μ)
+    assert [p.name for p in (tmp_path / "sub").iterdir()] == ["ms.npz"]
+    monkeypatch.setattr(ms, "DATA_PATH", path)
+    ms.reload_tables()
+    try:
+        np.testing.assert_array_equal(ms.table("ggx", "v-groove"), t)
+    finally:
+        monkeypatch.undo()
+        ms.reload_tables()
+    assert ms.table("ggx", "v-groove")[-1, -1] != t[-1, -1]  # the shipped file again

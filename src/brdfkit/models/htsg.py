@@ -58,8 +58,9 @@ surface, so the roughness the light sees is
 With ``x = z0/σ0`` the equation is ``x² e^(x²) = (K_i + K_r)² / (8π)``, so
 ``x² = W((K_i + K_r)²/(8π))`` with Lambert's W (principal branch): the
 equation has exactly one root and this closed form finds it without a
-bracket. W is computed by Newton's method on ``w + ln w = ln z`` (robust: it
-never forms z, which overflows at grazing angles), started at ln(1+z) for
+bracket. W (:func:`brdfkit.terms.special.lambertw_log`) is computed by Newton's
+method on ``w + ln w = ln z`` (robust: it never forms z, which overflows at
+grazing angles), started at ln(1+z) for
 z ≤ e and at ln z − ln ln z otherwise, 5 iterations; it agrees with
 ``scipy.special.lambertw`` to 1e-13 relative (tested), and substituting the
 root back into the paper's equation leaves a relative residual < 1e-10
@@ -88,69 +89,21 @@ RMS slope ``m = 2σ/τ``: for large g, ``Σ → e^(−a)/g`` with
 The series
 ----------
 ``Σ(g, T) = Σ_{m≥1} e^(−g) g^m / (m!·m) · e^(−T/m)`` with ``T = (πτ/λ)²
-|wi_xy + wo_xy|²`` is evaluated by :func:`htsg_series` (internally as
-``ln(Σ/g)``, which stays finite as g → 0) for every g ≥ 0 and T ≥ 0. Two
-tiers:
+|wi_xy + wo_xy|²`` (eq. 78's sum) is evaluated as ``ln(Σ/g)`` by
+:mod:`brdfkit.terms.htsg_series`, for every g ≥ 0 and T ≥ 0: a windowed,
+thinned direct sum for g < 40 and far in the tail, an asymptotic expansion in
+1/g with exact rational coefficients (its leading term Beckmann's rough-surface
+limit) in and around the lobe of large g. Relative error ≤ 1e-6 (measured:
+≤ 1.6e-7, at g = 40) over 1e-4 ≤ g ≤ 1e5, which covers the parameter range
+(g ≤ (4π σ0/λ)² ≤ 1.6e4 for σ0 ≤ 2 µm, λ ≥ 200 nm). Its special functions
+(Lambert W, ln m!, Stirling's series, Loader's deviance) are in
+:mod:`brdfkit.terms.special`.
 
-* **Direct sum** (g < 40, or far in the tail: a = T/g above the bound below).
-  The summand is a smooth, single-peaked function of m; its peak is the
-  saddle point ``m* = g·exp(W(2T/g²)/2)`` (the root of ln(m/g) = T/m²; for
-  T = 0 it is the Poisson mean g, in the tail it moves to larger m) and its
-  width ``σ_m = (1/m* + 2T/m*³)^(−1/2)``. **Truncation:** the sum runs over
-  ``m ∈ [m* − 6σ_m, m* + 7σ_m + 3] ∩ [1, ∞)``; the terms left out are
-  below 1e-9 of the sum (measured against the same sum over a window twice as wide, at 20000
-  random (g, T): ≤ 7.8e-10, the same as with the previous, two terms wider window; the GLSL
-  twin keeps that one). Each term is
-  computed directly relative to the one at m_c = round(m*),
-  ``exp((m − m_c)(ln g + T/(m·m_c)) − [ln(m!·m) − ln(m_c!·m_c)])``, with ln(m!·m) from a
-  table built at import (m < 32768, which holds every window over the parameter range; Stirling's
-  series above), so nothing overflows and the loop over m is a reduction of independent terms; the
-  peak's own term is computed without cancellation ("Evaluation in bulk" below). **Thinning:** where the peak is wide, only every h-th
-  term is taken and the sum multiplied by h. By Poisson summation, ``h Σ_j t(a + jh)``
-  differs from ``Σ_m t(m)`` by the summand's lattice characteristic function at ν = k/h,
-  k = 1..h−1; for a Poisson(g) summand that is ``exp(−g(1 − cos 2πk/h))``. The step is the
-  largest h with ``σ_m² (1 − cos(2π/h)) ≥ 30`` (bound 2e^(−30) ≈ 2e-13 in the Poisson case),
-  and h = 1 wherever the m = 1 term exceeds e^(−30) of the peak (the summand is cut off
-  there, and the 1/m factor's pole at m = 0 then leaves a slowly decaying remainder of order
-  g ln g e^(−g)). Measured against the long sum at 6000 random (g, T), 1e-4 ≤ g ≤ 2e4:
-  ≤ 1.3e-9 (the long sum's own rounding at g > 1e3 is of that order). About 13σ_m/h + 3 terms:
-  a few dozen for g < 30, ~16 for wide peaks whatever g.
-* **Asymptotic form** (g ≥ 40 and ``a = T/g ≤ 0.5·g^0.55``, i.e. large g,
-  in and around the lobe): writing ``e^(−T/m)/m`` as a Laplace transform,
-  ``Σ = ∫₀^∞ J0(2√(Tt)) (e^(−g(1−e^(−t))) − e^(−g)) dt``; expanding about
-  t = 0 in powers of 1/g and integrating term by term with
-  ``∫ e^(−s) s^k J0(2√(as)) ds = k! e^(−a) L_k(a)`` (Laguerre polynomials)
-  gives, after taking the logarithm,
-
-      Σ ≈ (e^(−a)/g) · exp(Σ_{n=1}^{6} Q_n(a)/g^n),   Q_1 = 1 − 2a + a²/2, …
-
-  (Q_n has degree n+1; the coefficients are derived exactly with rationals at
-  import, :func:`asymptotic_coefficients`, ``ASYMPTOTIC_ORDER = 6``). The
-  leading term is Beckmann's rough-surface limit. Its relative error in its
-  region is at most 1.6e-7, at its lower corner (g = 40, T ≈ 152; 1.2e-7 at g = 41.5,
-  9.8e-8 near g ≈ 43; checked against mpmath in ``tests/test_reliability_docs.py``),
-  falling fast with g.
-
-**Evaluation in bulk.** The per-pair kernel, :func:`htsg_kernel`, runs the series of one pair
-at a time; its loop over m has a length that varies from pair to pair, so LLVM cannot vectorise
-across pairs there. The compiled engine runs :func:`htsg_span` instead: the same functions composed
-block by block of pairs, each step one loop over the block (set-up, the t-th term of every window at
-once, values), each vectorised across pairs, the windows' terms taken longest window first so that
-a term is computed only for the pairs that have one; the choices inside the functions are
-:func:`brdfkit.engine.select` (no branch around a math call). Its math functions are the vector math
-library's (4 ulp), which the value must not amplify: the peak's term ``(m−1) ln g − g − ln(m!·m) −
-T/m`` is a difference of numbers of ~m ln m (up to ~4e4) and would carry m times the error of ln g;
-it is computed instead as ``−ln g − bd0(m, g) − [ln m! − m ln m + m] − ln m − T/m`` with Loader's
-deviance ``bd0`` (:func:`poisson_deviance`, :func:`stirling_remainder`), whose parts are all small,
-and the other terms relative to it (:func:`term_rel`). The two engines agree to 1e-12 (measured:
-≤ 2.3e-13 over 48 × 1500 random pairs and random parameters, tails included; the old form with the
-vector library's ln g differed by 1.4e-11 far in the tail).
-
-**Accuracy** (tests): relative error ≤ 1e-6 (measured: ≤ 1.6e-7, at g = 40) against a long
-log-space sum over every m and against 40-digit mpmath sums, for
-1e-4 ≤ g ≤ 1e5 and any T ≥ 0 (tested where Σ/g ≥ 1e-300; ``ln(Σ/g)`` stays
-accurate below that, only the value itself underflows to 0 far outside the lobe). These g cover the whole
-parameter range: g ≤ (4π σ0/λ)² ≤ 1.6e4 for σ0 ≤ 2 µm, λ ≥ 200 nm.
+The per-pair kernel is :func:`htsg_kernel` (the reference engine runs it, the
+compiled one for a few pairs); for more, the compiled engine runs
+:func:`htsg_span`, the same functions composed block by block of pairs so that
+LLVM vectorises across pairs (the series module's "Evaluation in bulk"). The
+two engines agree to 1e-12.
 
 Parameters
 ----------
@@ -181,355 +134,37 @@ approximate optical constants of aluminium at the three wavelengths (after Raki�
 
 from __future__ import annotations
 
-import decimal
 import math
-from fractions import Fraction
-from math import comb, factorial
 
 import numpy as np
 
 from ..engine import jit, select, vectorize
-from ..engine.driver import SPAN_VECTOR_WIDTH
 from ..params import Param
 from ..registry import register
 from ..terms.fresnel import f_conductor, fresnel_conductor
+from ..terms.htsg_series import (
+    ASYMPTOTIC_A_POWER,
+    ASYMPTOTIC_A_SCALE,
+    ASYMPTOTIC_G,
+    ASYMPTOTIC_ORDER,
+    SORT_BINS,
+    asymptotic_coefficients,
+    direct_finish,
+    htsg_log_series_ratio,
+    htsg_series,
+    log_series_ratio,
+    span_terms,
+    span_window,
+)
+from ..terms.special import exp_by_halves, lambertw_from_log, lambertw_log
 from .base import BRDF
 
-#: g at and above which the asymptotic form may be used
-ASYMPTOTIC_G = 40.0
-#: number of correction orders Q_1..Q_N in the asymptotic form
-ASYMPTOTIC_ORDER = 6
-#: the asymptotic form is used for a = T/g <= ASYMPTOTIC_A_SCALE * g**ASYMPTOTIC_A_POWER
-ASYMPTOTIC_A_SCALE = 0.5
-ASYMPTOTIC_A_POWER = 0.55
-#: window of the direct sum, in units of the peak width σ_m, left and right of the saddle point
-WINDOW_LEFT = (6.0, 0.0)  # m* − 6 σ_m
-WINDOW_RIGHT = (7.0, 3.0)  # m* + 7 σ_m + 3
-
 _SQRT_PI = math.sqrt(math.pi)
-_HALF_LN_2PI = 0.5 * math.log(2.0 * math.pi)
 _TINY = 1e-300
 #: cap on S(θ)/cos θ: reached only for cos θ < 1e-150 with σ0 below ~1e-150 (no shadowing left to
 #: cancel the 1/cos); with it the product S_i S_o |v|⁴/(cos θi cos θr) stays finite, never 0·∞
 SHADOW_OVER_COS_CAP = 1e150
 _LN_8PI = math.log(8.0 * math.pi)
-#: the smallest positive double: ln of it keeps Newton's step finite should W's start round to 0
-_W_FLOOR = 5e-324
-
-
-# ---------------------------------------------------------------------------
-# Lambert W (principal branch, real argument z >= 0), given ln z
-# ---------------------------------------------------------------------------
-@jit(inline=True)
-def exp_by_halves(x):
-    """``e^x`` for x ≤ 1400 as ``(e^(x/2))²``, the half's argument kept at or above −700: glibc's vector exp
-    redoes an argument below ~−708 (a subnormal or zero result) by a scalar call, lane by lane (measured in a
-    compiled loop: 17–77 ns per element against 1.4–1.6 in range). Below −1400 the square is 0, as e^x is
-    in doubles (below e^−744.4)."""
-    half = math.exp(max(0.5 * x, -700.0))
-    return half * half
-
-
-@jit(inline=True)
-def lambertw_log(lz, iterations):
-    """W(z) for ``z = exp(lz)`` ≥ 0 (``lz = -inf`` gives 0), without forming z when it would overflow.
-
-    Newton's method on ``h(w) = w + ln w − ln z`` (concave, increasing), started at
-    ``ln(1 + z) ≥ W(z)`` for z ≤ e (the first step lands in (0, W(z)]) and at
-    ``ln z − ln ln z ≤ W(z)`` for z > e; from the left Newton converges monotonically and
-    quadratically. 5 iterations reach machine precision for every ``lz`` in [-700, 1e300]
-    (tested); below −700, W(z) = z to double precision. Both starts and the small-z value are
-    computed for every ``lz`` and the right one selected (no branch around a math call: a loop
-    over pairs calling this vectorises, :func:`htsg_span`); each math call's argument is kept
-    in its domain, so the discarded ones stay finite.
-    """
-    z = max(lz, -700.0)  # below, the small-z value is selected: the iteration runs on finite numbers
-    big = max(z, 1.0)
-    w = select(z <= 1.0, math.log1p(math.exp(min(z, 1.0))), big - math.log(big))
-    for _ in range(int(iterations)):
-        w = w - (w + math.log(max(w, _W_FLOOR)) - z) * w / (w + 1.0)
-    return select(lz < -700.0, exp_by_halves(min(lz, -700.0)), w)  # W(z) = z below
-
-
-_lambertw_v = vectorize(lambertw_log, 2)
-
-
-def lambertw_from_log(lz, iterations: int = 5) -> np.ndarray:
-    """Array form of :func:`lambertw_log` (float64, broadcasting)."""
-    return _lambertw_v(lz, float(iterations))
-
-
-# ---------------------------------------------------------------------------
-# The asymptotic expansion's coefficients, derived exactly
-# ---------------------------------------------------------------------------
-def _poly_mul(p, q, order):
-    out: dict = {}
-    for (n1, k1), c1 in p.items():
-        for (n2, k2), c2 in q.items():
-            n = n1 + n2
-            if n <= order:
-                out[(n, k1 + k2)] = out.get((n, k1 + k2), 0) + c1 * c2
-    return out
-
-
-def asymptotic_coefficients(order: int = ASYMPTOTIC_ORDER) -> list[list[Fraction]]:
-    """``Q_n(a)`` coefficients (index = power of a), n = 0..order, of ln(g Σ e^a) = Σ_n Q_n(a)/g^n.
-
-    With t = s/g: ``g(1 − e^(−s/g)) = s − Σ_{j≥2} (−1)^j s^j/(j! g^(j−1))``, so the
-    integrand is ``e^(−s) exp(E)``, ``E = Σ_{j≥2} (−1)^j s^j ε^(j−1)/j!``, ε = 1/g;
-    exp(E) is expanded in ε, each ``s^k`` integrates to ``k! L_k(a)`` (times e^(−a)),
-    and the logarithm of the resulting series in ε gives Q_n.
-    """
-    E = {(j - 1, j): Fraction((-1) ** j, factorial(j)) for j in range(2, order + 2)}
-    exp_e: dict = {(0, 0): Fraction(1)}
-    term: dict = {(0, 0): Fraction(1)}
-    for r in range(1, order + 1):
-        term = {key: c / r for key, c in _poly_mul(term, E, order).items()}
-        for key, c in term.items():
-            exp_e[key] = exp_e.get(key, 0) + c
-    # P_n(a) = Σ_k c_{n,k} k! L_k(a),  L_k(a) = Σ_i C(k,i) (−a)^i / i!
-    P = [[Fraction(0)] * (2 * order + 1) for _ in range(order + 1)]
-    for (n, k), c in exp_e.items():
-        for i in range(k + 1):
-            P[n][i] += c * factorial(k) * comb(k, i) * Fraction((-1) ** i, factorial(i))
-    X = {(n, i): c for n in range(1, order + 1) for i, c in enumerate(P[n]) if c}
-    Q: dict = {}
-    power: dict = {(0, 0): Fraction(1)}
-    for r in range(1, order + 1):
-        power = _poly_mul(power, X, order)
-        for key, c in power.items():
-            Q[key] = Q.get(key, 0) + c * Fraction((-1) ** (r + 1), r)
-    out = [[Fraction(0)] * (n + 2) for n in range(order + 1)]
-    for (n, i), c in Q.items():
-        if c:
-            out[n][i] += c  # degree of Q_n is n + 1 (higher powers cancel exactly)
-    return out
-
-
-#: Q_0..Q_N as float arrays (index = power of a); the GLSL twin's htsg_q<n> hold the same numbers
-_Q = [np.array([float(c) for c in q]) for q in asymptotic_coefficients(ASYMPTOTIC_ORDER)]
-#: the same, flattened (a tuple, a compile-time constant for numba): Q_n's coefficients (power of
-#: a ascending) start at _Q_OFF[n] and number n + 2
-_Q_FLAT = tuple(float(c) for q in _Q for c in q)
-_Q_OFF = tuple(int(x) for x in np.cumsum([0] + [len(q) for q in _Q])[:-1])
-
-
-@jit(inline=True)
-def asymptotic_log_ratio(g, T):
-    """ln(Σ/g) from the asymptotic form ``Σ ≈ (e^(−a)/g)·exp(Σ_n Q_n(a)/g^n)``, a = T/g (module docstring)."""
-    a = T / g
-    eps = 1.0 / g
-    corr = 0.0
-    for n in range(ASYMPTOTIC_ORDER, 0, -1):
-        off = _Q_OFF[n]
-        poly = _Q_FLAT[off + n + 1]
-        for i in range(n, -1, -1):
-            poly = poly * a + _Q_FLAT[off + i]
-        corr = (corr + poly) * eps
-    return -a - 2.0 * math.log(g) + corr
-
-
-# ---------------------------------------------------------------------------
-# The directional-diffuse series
-# ---------------------------------------------------------------------------
-#: ln(m!·m) is tabulated for m below this (the direct sum's terms need no lgamma there)
-LN_TABLE_SIZE = 32768
-_LN_FACT_M = np.array([0.0] + [math.lgamma(m + 1.0) + math.log(m) for m in range(1, LN_TABLE_SIZE)])
-#: the direct sum takes every h-th term where ``var·(1 − cos(2π/h)) ≥ THIN_MARGIN`` (module docstring)
-THIN_MARGIN = 30.0
-#: Newton iterations of W for the saddle point (the window's position: m* to 5e-5 relative)
-SADDLE_W_ITERATIONS = 2.0
-
-
-#: :func:`stirling_remainder` sums Stirling's series from this m on (below, a table)
-STIRLING_SERIES_FROM = 64
-
-
-def _stirling_remainders(n: int) -> np.ndarray:
-    """``ln m! − (m + ½) ln m + m − ½ ln 2π`` for m = 0..n−1 (0 unused) in 40-digit decimal arithmetic, each
-    rounded once to a double."""
-    out = np.zeros(n)
-    with decimal.localcontext() as ctx:
-        ctx.prec = 40
-        D = decimal.Decimal
-        half_ln_2pi = (D(2) * D("3.141592653589793238462643383279502884197")).ln() / 2
-        lnfact = D(0)
-        for m in range(1, n):
-            lnm = D(m).ln()
-            lnfact += lnm
-            out[m] = float(lnfact - (D(m) + D("0.5")) * lnm + D(m) - half_ln_2pi)
-    return out
-
-
-#: Stirling's remainder below STIRLING_SERIES_FROM, where its series does not converge fast enough
-_STIRLERR_SMALL = _stirling_remainders(STIRLING_SERIES_FROM)
-
-
-@jit(inline=True)
-def stirling_remainder(m):
-    """``ln m! − [(m + ½) ln m − m + ½ ln 2π]`` for an integer-valued m ≥ 1: small (1/(12m)), so it keeps its
-    accuracy where ln m! would not. A table below :data:`STIRLING_SERIES_FROM`, Stirling's series from there (terms
-    to 1/(1188 m⁹); the next, 691/(360360 m¹¹), is below 3e-23 there)."""
-    x = max(m, STIRLING_SERIES_FROM)
-    r = 1.0 / (x * x)
-    series = (1.0 / 12.0 - r * (1.0 / 360.0 - r * (1.0 / 1260.0 - r * (1.0 / 1680.0 - r * (1.0 / 1188.0))))) / x
-    return select(m < STIRLING_SERIES_FROM, _STIRLERR_SMALL[min(int(m), STIRLING_SERIES_FROM - 1)], series)
-
-
-@jit(inline=True)
-def stirling_ln_fact_times_m(m):
-    """``ln(m!·m) = (m + 3/2) ln m − m + ½ ln 2π + stirling_remainder(m)`` (Stirling's formula with its
-    remainder, :func:`stirling_remainder`), for m at and above LN_TABLE_SIZE."""
-    return (m + 1.5) * math.log(m) - m + _HALF_LN_2PI + stirling_remainder(m)
-
-
-@jit(inline=True)
-def ln_fact_times_m(m):
-    """``ln(m!·m)`` for an integer-valued m ≥ 1: the module table below LN_TABLE_SIZE, Stirling's series
-    above (both computed, one selected: no branch, no libm lgamma, so a loop over it vectorises)."""
-    return select(m < LN_TABLE_SIZE, _LN_FACT_M[min(int(m), LN_TABLE_SIZE - 1)], stirling_ln_fact_times_m(m))
-
-
-#: :func:`poisson_deviance` sums its series where ``|m − g| < DEVIANCE_SERIES·(m + g)``
-DEVIANCE_SERIES = 0.25
-
-
-@jit(inline=True)
-def poisson_deviance(m, g):
-    """``m ln(m/g) + g − m`` ≥ 0 (m ≥ 1, g > 0) without cancellation (C. Loader, "Fast and accurate computation
-    of binomial probabilities", 2000: its ``bd0``). With ``v = (m − g)/(m + g)``, ``ln(m/g) = 2 atanh v``
-    gives ``(m − g)·v + 2m·v³·(1/3 + v²/5 + … + v²⁶/29)`` for |v| < :data:`DEVIANCE_SERIES` (the next term is
-    below 2e-18 of it), and the plain form elsewhere (where its two parts cancel by at most a factor 5). The
-    GLSL twin writes it as ``m·htsg_phi((g − m)/m)``, ``φ(x) = x − log1p(x)``, the same series in float32.
-    Both are computed, one selected (no branch)."""
-    d = m - g
-    v = d / (m + g)
-    v2 = v * v
-    tail = 1.0 / 29.0
-    for k in (27.0, 25.0, 23.0, 21.0, 19.0, 17.0, 15.0, 13.0, 11.0, 9.0, 7.0, 5.0, 3.0):
-        tail = tail * v2 + 1.0 / k
-    series = d * v + 2.0 * m * v * v2 * tail
-    plain = m * math.log(m / g) + g - m
-    return select(abs(v) < DEVIANCE_SERIES, series, plain)
-
-
-@jit(inline=True)
-def log_term(m, lg, g, T):
-    """ln of the m-th term of Σ/g, ``(m−1) ln g − g − ln(m!·m) − T/m`` (integer-valued m ≥ 1), as
-    ``−ln g − bd0(m, g) − [ln m! − m ln m + m] − ln m − T/m`` (:func:`poisson_deviance`, :func:`stirling_remainder`):
-    every part is small, so nothing cancels. Written as the first form, the parts are ~m ln m (up to ~4e4 over
-    the parameter range) and their difference a few units: an error of δ in ln g moves it by m·δ."""
-    return -lg - poisson_deviance(m, g) - stirling_remainder(m) - 1.5 * math.log(m) - _HALF_LN_2PI - T / m
-
-
-@jit(inline=True)
-def term_rel(m, ln_fm, mc, ln_fmc, lg, T):
-    """ln of the m-th term of Σ/g relative to the mc-th: ``(m − mc)·(ln g + T/(m·mc)) − [ln(m!·m) − ln(mc!·mc)]``,
-    with ``ln_fm = ln(m!·m)`` and ``ln_fmc = ln(mc!·mc)`` given (the table's values, or :func:`ln_fact_times_m`).
-    An error of δ in ln g moves it by (m − mc)·δ: for the terms that count, a few σ_m."""
-    return (m - mc) * (lg + T / (m * mc)) - (ln_fm - ln_fmc)
-
-
-@jit(inline=True)
-def thinning_step(var, edge):
-    """The step h of the direct sum: the largest integer with ``var·(1 − cos(2π/h)) ≥ THIN_MARGIN``.
-
-    ``var`` is the summand's variance σ_m², ``edge`` the log of its m = 1 term relative to the
-    peak's. h = 1 (every term) unless the summand is negligible at m = 1 (``edge < −THIN_MARGIN``):
-    cut off there, it is not a smooth peak and the lattice argument of the module docstring
-    does not hold. (The arc cosine is taken for every var, of an argument kept in [−1, 1).)
-    """
-    x = 1.0 - THIN_MARGIN / max(var, 0.5 * THIN_MARGIN)
-    step = max(math.floor(2.0 * math.pi / math.acos(x)), 1.0)
-    return select(edge > -THIN_MARGIN or 2.0 * var <= THIN_MARGIN, 1.0, step)
-
-
-@jit(inline=True)
-def direct_window(g, T, lg):
-    """The direct sum's window for g > 0, T ≥ 0 and ``lg = ln g``: ``(mc, h, jlo, jhi, peak)``.
-
-    The terms are m = mc + j·h for j in [jlo, jhi] (every h-th, :func:`thinning_step`), around the
-    saddle point m* = g exp(W(2T/g²)/2) (width σ_m = (1/m* + 2T/m*³)^(−1/2)); ``peak`` is ln of the
-    term at ``m_c = round(m*)`` (:func:`log_term`, where ``lg = ln g`` only adds). Branch-free (a loop over
-    pairs vectorises)."""
-    w = lambertw_log(math.log(max(2.0 * T, _TINY)) - 2.0 * lg, SADDLE_W_ITERATIONS)  # not used for T = 0
-    mstar = max(g * math.exp(0.5 * select(T > 0.0, w, 0.0)), 1.0)
-    var = 1.0 / (1.0 / mstar + 2.0 * T / (mstar * mstar * mstar))
-    sig = math.sqrt(max(var, 0.0))
-    lo = max(math.floor(mstar - WINDOW_LEFT[0] * sig - WINDOW_LEFT[1]), 1.0)
-    hi = math.ceil(mstar + WINDOW_RIGHT[0] * sig + WINDOW_RIGHT[1])
-    mc = min(max(math.floor(mstar + 0.5), lo), hi)
-    peak = log_term(mc, lg, g, T)
-    h = thinning_step(var, -g - T - peak)  # log_term(1) = −g − T
-    jlo = -math.floor((mc - lo) / h)
-    jhi = math.floor((hi - mc) / h)
-    return mc, h, jlo, jhi, peak
-
-
-@jit(reassociate=True)
-def direct_sum(lg, T, mc, h, jlo, jhi):
-    """Σ_j exp(ln t_m − ln t_mc) over the window of :func:`direct_window`, in order of j.
-
-    Each term is relative to the peak's (:func:`term_rel`: nothing overflows or underflows near it), with
-    ln(m!·m) read from the module table where the whole window lies below its end. Compiled with
-    ``reassociate`` (the terms are positive): LLVM vectorises the sum of one pair, 8 terms per
-    vector exp (libmvec, :mod:`brdfkit.engine.vecmath`); :func:`htsg_span` sums many pairs at
-    once instead, each in this order."""
-    acc = 0.0
-    ln_fmc = ln_fact_times_m(mc)
-    if mc + jhi * h < LN_TABLE_SIZE:
-        k0 = int(mc)
-        ih = int(h)
-        for j in range(int(jlo), int(jhi) + 1):  # ln(m!·m) read from the table (no branch)
-            acc += math.exp(term_rel(mc + j * h, _LN_FACT_M[k0 + j * ih], mc, ln_fmc, lg, T))
-    else:
-        for j in range(int(jlo), int(jhi) + 1):
-            m = mc + j * h
-            acc += math.exp(term_rel(m, ln_fact_times_m(m), mc, ln_fmc, lg, T))
-    return acc
-
-
-@jit(inline=True)
-def direct_finish(peak, h, acc):
-    """ln(Σ/g) from the window's peak, step and sum: ``peak + ln(h·acc)`` (acc ≥ 1: the peak's own term)."""
-    return peak + math.log(max(h * acc, _TINY))
-
-
-@jit
-def direct_log_ratio(g, T):
-    """ln(Σ/g) by the windowed direct sum (g > 0, T ≥ 0): :func:`direct_window`, :func:`direct_sum`,
-    :func:`direct_finish` (module docstring, "The series")."""
-    lg = math.log(g)
-    mc, h, jlo, jhi, peak = direct_window(g, T, lg)
-    return direct_finish(peak, h, direct_sum(lg, T, mc, h, jlo, jhi))
-
-
-@jit(inline=True)
-def asymptotic_tier(g, T):
-    """Whether ln(Σ/g) at (g, T) is taken from the asymptotic form (g ≥ 40, a = T/g ≤ 0.5 g^0.55)."""
-    return g >= ASYMPTOTIC_G and T / g <= ASYMPTOTIC_A_SCALE * math.exp(ASYMPTOTIC_A_POWER * math.log(g))
-
-
-@jit
-def log_series_ratio(g, T):
-    """``ln(Σ(g, T)/g)`` (finite for g ≥ 0, T ≥ 0; g = 0 gives −T, the limit): the two tiers."""
-    g = max(g, _TINY)
-    T = max(T, 0.0)
-    if asymptotic_tier(g, T):
-        return asymptotic_log_ratio(g, T)
-    return direct_log_ratio(g, T)
-
-
-_asymptotic_log_ratio = vectorize(asymptotic_log_ratio, 2)
-_direct_log_ratio = vectorize(direct_log_ratio, 2)
-htsg_log_series_ratio = vectorize(log_series_ratio, 2)
-htsg_log_series_ratio.__doc__ = "``ln(Σ(g, T)/g)`` elementwise, float64 (array form of :func:`log_series_ratio`)."
-
-
-def htsg_series(g, T) -> np.ndarray:
-    """``Σ_{m≥1} e^(−g) g^m / (m!·m) · e^(−T/m)`` (HTSG eq. 78's sum), elementwise, float64."""
-    g = np.asarray(g, dtype=np.float64)
-    return g * np.exp(htsg_log_series_ratio(g, T))
 
 
 # ---------------------------------------------------------------------------
@@ -681,11 +316,6 @@ def htsg_kernel(wix, wiy, wiz, wox, woy, woz, p, c):
 
 #: pairs per block of :func:`htsg_span` (its scratch: 11 arrays of 3 × SPAN_BLOCK values)
 SPAN_BLOCK = 64
-#: a window of more terms than this is not summed by :func:`htsg_span` (its pair's value is then
-#: that of an empty sum). Over the whole parameter range the direct sum's window holds at most 86
-#: terms (tested: ``test_htsg.py``); more, or a NaN count, only comes of directions that are not unit
-#: vectors, which ``eval`` rejects after evaluating: the cap bounds that work and keeps it finite.
-WINDOW_CAP = 4096.0
 
 
 @jit(inline=True)
@@ -694,100 +324,6 @@ def span_channel(lam_nm, eta, k, ks, sigma, tau, vz, vxy2, cl):
     takes them (:func:`channel_gT`), and ``weight = ks·F·scale`` (:func:`channel_value`)."""
     g, T, scale = channel_gT(lam_nm, sigma, tau, vz, vxy2)
     return max(g, _TINY), max(T, 0.0), ks * f_conductor(cl, eta, k) * scale
-
-
-@jit(inline=True)
-def span_window(g, T, ok):
-    """One channel's series set-up for :func:`htsg_span`, step 1: ``(lg, T, base, h, count, mc, ln_fmc, peak,
-    asym)``.
-
-    The direct sum's window (:func:`direct_window`) as its first term ``base``, step ``h``, ``count`` of
-    terms (0 where nothing is to be summed: the pair is below the horizon, the asymptotic form applies, or the
-    count is beyond :data:`WINDOW_CAP`; such a pair's other numbers are replaced by harmless values, its
-    terms being masked), its peak's ``mc`` and ``ln(mc!·mc)``, and the asymptotic form's ln(Σ/g) where it
-    applies (NaN elsewhere)."""
-    lg = math.log(g)
-    asym = asymptotic_tier(g, T)
-    av = asymptotic_log_ratio(max(g, ASYMPTOTIC_G), T)
-    mc, h, jlo, jhi, peak = direct_window(g, T, lg)
-    count = jhi - jlo + 1.0
-    live = ok and not asym and count <= WINDOW_CAP  # False for a NaN count
-    mc = select(live, mc, 1.0)
-    return (select(live, lg, 0.0), select(live, T, 0.0), select(live, mc + jlo * h, 1.0), select(live, h, 1.0),
-            select(live, count, 0.0), mc, ln_fact_times_m(mc), select(live, peak, 0.0), select(asym, av, math.nan))
-
-
-#: :func:`span_terms` runs the loop over pairs to a multiple of this many, the surplus lanes masked, so it has
-#: no scalar remainder: the span drivers' vector width on AVX-512 (8 doubles; on AVX2 the cost model's 2 × 4)
-SPAN_LANES = SPAN_VECTOR_WIDTH
-#: :func:`span_terms` sorts the counts 0 .. SORT_BINS − 1 (every window over the parameter range: at most 86)
-SORT_BINS = 128
-
-
-# inlined (numba IR) into htsg_span, which only a span driver compiles (under its LLVM options): as a function of
-# its own its code was disk-cached by whichever process compiled it first, with or without those options (a
-# direct call compiles it without), and then linked into span drivers compiled later (a suspected cause of the
-# serial and parallel span drivers' last-bit differences, tests/test_engine.py)
-@jit(inline=True)
-def span_terms(LG, TT, BASE, H, CNT, MC, LFC, ACC, m, S, order, bins):
-    """Sum the windows' terms of one channel into ``ACC[:m]``, the t-th term of the block's ``m`` pairs at once
-    (:func:`htsg_span`, step 2), each pair's in the order of :func:`direct_sum`.
-
-    The pairs are taken longest window first (a counting sort of the counts, up to :data:`SORT_BINS` − 1 and
-    those above in any order, the numbers copied into the scratch ``S``, ``order`` an integer scratch): at the
-    t-th term only a prefix of them has one, and the loop over pairs stops there (rounded up to
-    :data:`SPAN_LANES`, the lanes past it masked; a pair is left out only once its count is at most t, so the
-    sums do not depend on the order). Windows vary from 1 to ~86 terms, so in the order of
-    the pairs every term was computed for as many pairs as the block's longest window has terms (47 for an
-    average of 31 at the default parameters, 55 for 14 at σ0 = 0.8); each pair's own sum is the same."""
-    nb = S.shape[1]
-    bins[:] = 0
-    for i in range(m):
-        bins[min(int(CNT[i]), SORT_BINS - 1)] += 1
-    start = 0
-    for b in range(SORT_BINS - 1, -1, -1):  # bins[b]: where count b's pairs start, longest first
-        c = bins[b]
-        bins[b] = start
-        start += c
-    for i in range(m):
-        b = min(int(CNT[i]), SORT_BINS - 1)
-        order[bins[b]] = i
-        bins[b] += 1
-    S[:, m:] = 0.0  # past m: a harmless, empty window (BASE, H, MC 1)
-    S[2, m:] = 1.0
-    S[3, m:] = 1.0
-    S[5, m:] = 1.0
-    S[7, :] = 0.0  # the sums
-    table = True  # every window within the ln(m!·m) table
-    for r in range(m):
-        i = order[r]
-        S[0, r] = LG[i]
-        S[1, r] = TT[i]
-        S[2, r] = BASE[i]
-        S[3, r] = H[i]
-        S[4, r] = CNT[i]
-        S[5, r] = MC[i]
-        S[6, r] = LFC[i]
-        table = table and BASE[i] + (CNT[i] - 1.0) * H[i] < LN_TABLE_SIZE
-    SLG, STT, SBASE, SH, SCNT, SMC, SLFC, SACC = S[0], S[1], S[2], S[3], S[4], S[5], S[6], S[7]
-    live = m
-    for t in range(int(SCNT[0]) if m > 0 else 0):
-        tf = float(t)
-        while live > 0 and SCNT[live - 1] <= tf:
-            live -= 1
-        n = min(-(-live // SPAN_LANES) * SPAN_LANES, nb)
-        if table:
-            for r in range(n):
-                mm = SBASE[r] + tf * SH[r]
-                x = term_rel(mm, _LN_FACT_M[min(int(mm), LN_TABLE_SIZE - 1)], SMC[r], SLFC[r], SLG[r], STT[r])
-                SACC[r] += select(tf < SCNT[r], math.exp(select(tf < SCNT[r], x, 0.0)), 0.0)
-        else:
-            for r in range(n):
-                mm = SBASE[r] + tf * SH[r]
-                x = term_rel(mm, ln_fact_times_m(mm), SMC[r], SLFC[r], SLG[r], STT[r])
-                SACC[r] += select(tf < SCNT[r], math.exp(select(tf < SCNT[r], x, 0.0)), 0.0)
-    for r in range(m):
-        ACC[order[r]] = SACC[r]
 
 
 @jit(inline=True)
@@ -974,6 +510,8 @@ class HTSG(BRDF):
 
 __all__ = [
     "HTSG",
+    "htsg_kernel",
+    "htsg_span",
     "htsg_series",
     "htsg_log_series_ratio",
     "lambertw_from_log",
@@ -984,4 +522,6 @@ __all__ = [
     "z0_ratio_squared",
     "ASYMPTOTIC_G",
     "ASYMPTOTIC_ORDER",
+    "ASYMPTOTIC_A_SCALE",
+    "ASYMPTOTIC_A_POWER",
 ]
