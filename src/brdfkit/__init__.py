@@ -17,7 +17,7 @@ from .engine import set_engine
 from . import models
 from .models.base import BRDF
 
-__version__ = "0.1.0"
+from ._version import __version__
 
 
 def model_info(name: str) -> dict[str, Any]:
