@@ -90,10 +90,11 @@ def _refuse(name, option):
 _ll.set_option = _refuse
 """
 
-#: numba without the compiler lock where brdfkit looks for it, and the hook's edit of numba's module failing
+#: numba without the compiler lock where brdfkit looks for it (see test_compiler_lock_is_none_where_numba_lacks_it),
+#: and the hook's edit of numba's module failing
 NO_LOCK_EDIT_FAILS = """
-import numba.core.compiler_lock as _cl
-del _cl.global_compiler_lock  # numba's own modules hold it already; brdfkit's import of it fails
+import brdfkit.engine.llvm_options as _lo
+_lo.compiler_lock = lambda: None  # what it returns where numba has no lock there (numba itself needs its own)
 import brdfkit.engine.vecmath as _vm
 def _fail(library, edit):
     raise AttributeError("'JITCodeLibrary' object has no attribute '_final_module'")
@@ -157,3 +158,15 @@ def test_an_option_refused_in_process_turns_the_options_off_and_the_call_still_r
     with llvm_options.compile_options(16, interleave=2):
         ran.append(2)
     assert ran == [1, 2] and calls == []  # off: no further attempt, no further note
+
+
+def test_compiler_lock_is_none_where_numba_lacks_it(monkeypatch):
+    """Where ``numba.core.compiler_lock`` has no ``global_compiler_lock`` (a newer numba), the lookup gives None
+    (and :func:`compile_options` then sets no option). Removed here only for the lookup: numba needs it."""
+    import numba.core.compiler_lock as cl
+
+    from brdfkit.engine import llvm_options
+
+    assert llvm_options.compiler_lock() is cl.global_compiler_lock
+    monkeypatch.delattr(cl, "global_compiler_lock")
+    assert llvm_options.compiler_lock() is None

@@ -36,6 +36,7 @@ _LOCK = threading.Lock()
 
 
 def _load(key: tuple, stem: str, src: str) -> Callable:
+    """The ``drive`` of the generated module ``src`` (file ``<stem>.py``), loaded once per process by ``key``."""
     d = _DRIVERS.get(key)
     if d is not None:
         return d
