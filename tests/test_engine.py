@@ -13,7 +13,7 @@ import pytest
 
 import brdfkit as bk
 from brdfkit import engine
-from brdfkit.engine import driver, reference
+from brdfkit.engine import cost, driver, llvm_options, reference
 from brdfkit.geometry import random_unit_vectors
 from brdfkit.models.base import BRDF
 from brdfkit.params import kd_param
@@ -365,8 +365,8 @@ def test_forced_width_compile_hides_llvm_remarks_only():
     stderr; any other line written meanwhile still does (C-level fd 2, as LLVM writes it)."""
     code = (
         "import os\n"
-        "from brdfkit.engine.driver import _without_llvm_remarks\n"
-        "with _without_llvm_remarks():\n"
+        "from brdfkit.engine.llvm_remarks import without_llvm_remarks\n"
+        "with without_llvm_remarks():\n"
         "    os.write(2, b'remark: <unknown>:0:0: loop not vectorized: call instruction cannot be vectorized\\n')\n"
         "    os.write(2, b'a real warning\\n')\n"
         "os.write(2, b'after\\n')\n"
@@ -397,7 +397,7 @@ def test_compile_options_are_set_only_under_numbas_compiler_lock():
     t = threading.Thread(target=holder)
     t.start()
     held.wait()
-    with driver._compile_options(8, driver.SPAN_UNROLL_THRESHOLD, interleave=2):
+    with llvm_options.compile_options(8, llvm_options.SPAN_UNROLL_THRESHOLD, interleave=2):
         entered.append(("options set", time.perf_counter()))
         assert global_compiler_lock.is_locked()
     t.join()
@@ -425,14 +425,14 @@ def test_specialised_driver_runs_serially_or_in_parallel_with_the_same_bits(name
     serial = driver._SERIAL[key]
     monkeypatch.setitem(driver._SERIAL, key, lambda *a: (calls.append(1), serial(*a))[1])
     if numba.get_num_threads() > 1:
-        monkeypatch.setattr(driver, "PARALLEL_MIN_S", 0.0)
+        monkeypatch.setattr(cost, "PARALLEL_MIN_S", 0.0)
         par = m.eval(wi, wo)
         assert calls == []  # in parallel
     else:  # one thread: always serial
         par = m.eval(wi, wo)
         calls.clear()
     assert key in driver._PAIR_COST and driver._PAIR_COST[key] > 0
-    monkeypatch.setattr(driver, "PARALLEL_MIN_S", math.inf)
+    monkeypatch.setattr(cost, "PARALLEL_MIN_S", math.inf)
     ser = m.eval(wi, wo)
     assert calls == [1]
     assert ser.dtype == par.dtype == dtype

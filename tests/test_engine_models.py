@@ -359,8 +359,7 @@ def test_fortran_ordered_directions_give_the_same_bits(name, fixed):
                 np.testing.assert_array_equal(got, want)
             else:  # the float32 twins may fuse a·b + c (LLVM's contract): the two loops can fuse differently
                 np.testing.assert_allclose(got, want, rtol=1e-6, atol=0)
-            soa = driver.runs_soa(n, m.kernel_args()[0])
-            assert got.flags.f_contiguous == soa
+            assert got.flags.f_contiguous  # in place where driver.runs_soa, else copied back: always
             np.testing.assert_array_equal(m.eval(fa, b), want)  # mixed layouts: copied to rows
             bad = fa.copy(order="F")
             bad[n - 5] *= 1.01

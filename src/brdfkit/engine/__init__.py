@@ -85,74 +85,12 @@ float64 and round the result once. The reference engine always computes in float
 
 from __future__ import annotations
 
-import os
 import sys as _sys
 import types as _types
 
-ENGINES = ("compiled", "reference")
-ENV_VAR = "BRDFKIT_ENGINE"
-
-
-def _from_env() -> str:
-    v = os.environ.get(ENV_VAR, "").strip().lower()
-    if v == "":
-        return "compiled"
-    if v not in ENGINES:
-        raise ValueError(f"{ENV_VAR}={v!r} is not a valid engine; valid: {', '.join(ENGINES)}")
-    return v
-
-
-_current = _from_env()
-
-def _load_tbb() -> bool:
-    """True when numba's TBB threading layer can run here (PyPI's ``tbb`` wheel, installed with brdfkit).
-
-    The wheel puts ``libtbb.so.12`` in the environment's ``lib/``, which the dynamic loader does
-    not search: it is loaded here first (by its path, globally), so that numba's ``tbbpool``
-    finds it; numba's own version check must pass too. False on any failure: workqueue then.
-    """
-    import ctypes
-    import glob
-    from importlib.metadata import PackageNotFoundError, files
-
-    try:
-        candidates = [str(f.locate()) for f in files("tbb") or () if f.name.startswith("libtbb.so.12")]
-    except PackageNotFoundError:  # not installed by pip: perhaps in the environment's lib/ anyway
-        candidates = []
-    candidates += sorted(glob.glob(os.path.join(_sys.prefix, "lib", "libtbb.so.12*")))
-    for path in candidates:
-        try:
-            ctypes.CDLL(path, mode=ctypes.RTLD_GLOBAL)
-            break
-        except OSError:
-            continue
-    try:
-        from numba.np.ufunc import parallel as _parallel
-        from numba.np.ufunc import tbbpool  # noqa: F401  (fails without libtbb)
-
-        _parallel._check_tbb_version_compatible()
-    except Exception:  # ImportError, or numba without the check: not TBB
-        return False
-    return True
-
-
-#: numba's threading layer for the compiled drivers (set at import unless NUMBA_THREADING_LAYER is)
-THREADING_LAYER = os.environ.get("NUMBA_THREADING_LAYER", "")
-
-# numba's parallel loops run on its TBB threading layer where it loads (brdfkit depends on PyPI's
-# tbb): thread-safe (the explorer's server threads evaluate at once) and fork-safe (process pools:
-# `check --all --jobs`, batch fitting), and its workers spin a moment before they sleep, so that
-# the many short parallel calls of the engine find them awake (GGX on 2^20 pairs: median 480 M
-# evals/s against 200 on workqueue on the 2-vCPU development machine, where waking a sleeping
-# vCPU appears to take about a millisecond: inferred from those timings, not measured directly).
-# Otherwise "workqueue", which also survives fork() but is not reentrant: the driver then
-# serialises calls from several Python threads with a lock. GNU OpenMP, numba's other choice
-# here, aborts a forked child. An explicit NUMBA_THREADING_LAYER wins.
-if not THREADING_LAYER:
-    import numba as _numba
-
-    THREADING_LAYER = "tbb" if _load_tbb() else "workqueue"
-    _numba.config.THREADING_LAYER = THREADING_LAYER
+from . import active as _active
+from .active import ENGINES, ENV_VAR, engine, set_engine
+from .threads import THREADING_LAYER  # sets numba's threading layer, before any parallel driver runs
 
 
 def skip_blas_probe() -> bool:
@@ -181,29 +119,17 @@ def skip_blas_probe() -> bool:
     return True
 
 
-def set_engine(name: str) -> None:
-    """Select the evaluation engine: ``"compiled"`` (default) or ``"reference"``."""
-    global _current
-    if not isinstance(name, str) or name.strip().lower() not in ENGINES:
-        raise ValueError(f"unknown engine {name!r}; valid: {', '.join(ENGINES)}")
-    _current = name.strip().lower()
-
-
-def engine() -> str:
-    """The active evaluation engine's name."""
-    return _current
-
-
 class _CallableModule(_types.ModuleType):
     """``brdfkit.engine`` is this package and, called, the SPEC's ``bk.engine()``."""
 
     def __call__(self) -> str:
-        return _current
+        return _active._current
 
 
 _sys.modules[__name__].__class__ = _CallableModule
 
-from .cache import jit, vectorize  # noqa: E402
+from .cache import jit  # noqa: E402
+from .vectorize import vectorize  # noqa: E402
 from .evaluate import evaluate, check_unit  # noqa: E402
 from .select import select  # noqa: E402
 

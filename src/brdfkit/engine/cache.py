@@ -21,13 +21,11 @@ from __future__ import annotations
 
 import contextlib
 import hashlib
-import math
 import os
 from pathlib import Path
 from typing import Callable, Iterator
 
 import numba
-import numpy as np
 
 _PKG = Path(__file__).resolve().parent.parent
 
@@ -125,7 +123,7 @@ def prune(current: Path, now: float | None = None) -> list[Path]:
 @contextlib.contextmanager
 def in_cache_dir() -> Iterator[None]:
     """numba's ``CACHE_DIR`` set to :func:`cache_dir` while functions are decorated, then restored."""
-    old = numba.config.CACHE_DIR
+    old = getattr(numba.config, "CACHE_DIR", "")  # numba's setting (NUMBA_CACHE_DIR); "" where a numba lacks it
     numba.config.CACHE_DIR = str(cache_dir())
     try:
         yield
@@ -159,48 +157,4 @@ def jit(fn: Callable | None = None, *, inline: bool = False, reassociate: bool =
         return numba.njit(**opts)(fn)
 
 
-class vectorize:
-    """An array function over a scalar term: broadcasting, float64 computation, any output dtype.
-
-    ``vectorize(d_ggx)(hx, hy, hz, ax, ay)`` applies the scalar source element-wise: compiled, a
-    loop generated for it and cached on disk (:func:`brdfkit.engine.driver.elementwise_driver_for`,
-    loaded at the first call); under the reference engine the uncompiled Python function via
-    ``np.frompyfunc``. The result is float64; pass ``dtype=np.float32`` to round it once to float32.
-    """
-
-    def __init__(self, scalar: Callable, nargs: int) -> None:
-        self.scalar = scalar
-        self.nargs = nargs
-        self._drive = None
-        self.__doc__ = getattr(scalar, "__doc__", None)
-        self.__name__ = getattr(scalar, "__name__", "vectorized")
-
-    def _compiled(self, arrs: list[np.ndarray]) -> np.ndarray:
-        if self._drive is None:
-            from .driver import elementwise_driver_for
-
-            self._drive = elementwise_driver_for(self.scalar, self.nargs)
-        shape = np.broadcast_shapes(*(a.shape for a in arrs))
-        # 1-D views where numpy can give one (a contiguous array as is, a single value as stride 0), else copies
-        flat = [np.broadcast_to(a, shape).reshape(-1) for a in arrs]
-        out = np.empty(math.prod(shape))
-        self._drive(*flat, out)
-        return out.reshape(shape)
-
-    def __call__(self, *args, dtype=np.float64) -> np.ndarray:
-        from . import engine
-        from .reference import pure
-
-        if len(args) != self.nargs:
-            raise TypeError(f"{self.__name__} takes {self.nargs} arguments, got {len(args)}")
-        arrs = [np.asarray(a, dtype=np.float64) for a in args]
-        if engine() == "reference":
-            f = np.frompyfunc(pure(self.scalar), self.nargs, 1)
-            out = np.asarray(f(*arrs), dtype=np.float64)
-        else:
-            out = self._compiled(arrs)
-        with np.errstate(over="ignore"):
-            return np.asarray(out).astype(dtype, copy=False)
-
-
-__all__ = ["jit", "vectorize", "cache_dir", "prune", "source_hash", "in_cache_dir", "JIT_OPTIONS"]
+__all__ = ["jit", "cache_dir", "prune", "source_hash", "in_cache_dir", "JIT_OPTIONS"]

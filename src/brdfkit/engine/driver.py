@@ -1,307 +1,55 @@
-"""The parallel numba driver that runs a model's scalar kernel over flat direction arrays.
+"""The runner: which compiled driver a ``BRDF.eval`` call runs, how, and with what bookkeeping.
 
-For each kernel the driver is a small module generated from :data:`TEMPLATE`
-into the cache folder (:func:`brdfkit.engine.cache.cache_dir`) and imported from
-there. A generated file, rather than one generic driver taking the kernel as an
-argument or a closure over it, because numba caches neither of those on disk
-(a dispatcher-typed argument or free variable misses the cache in every new
-process); a module-level call of a global kernel is what its cache supports,
-and it lets LLVM inline the kernel into the loop.
+:func:`run` evaluates a model's scalar kernel over flat ``(n, 3)`` direction arrays with a driver
+generated from :mod:`.templates` and loaded by :mod:`.generated`:
 
-``drive(wi, wo, p, c, out, lim, nrm)``: ``wi``, ``wo``, ``out`` are C-contiguous
-``(n, 3)`` arrays of one dtype (float32 or float64); chunks of :data:`CHUNK`
-pairs run in parallel (``prange``; a single chunk runs inline, without the
-thread pool). Per pair the kernel is called with float64 components, and the
-result (0 where ``wi.z <= 0`` or ``wo.z <= 0``, clamped to ``lim``) stored in
-``out``. The same pass records the smallest and largest SQUARED direction
-lengths and a NaN count per chunk into ``nrm`` (``(nchunks, 6)``: wi min, max,
-nan, wo min, max, nan) for the unit-direction check of ``BRDF.eval``.
+* up to :data:`CHUNK` pairs, or a ``p`` that holds a table (longer than :data:`MAX_TUPLE`), the
+  generic driver (choices read at run time; a single chunk runs inline, without the thread pool);
+* more, the driver specialised for the call's choice combination (lazily generated, cached on disk),
+  whose loop LLVM vectorises; Fortran-ordered ``(n, 3)`` arrays run its structure-of-arrays form.
+  Its chunks run in parallel, or serially on the calling thread when numba has one thread or the
+  call's work, estimated from the driver's earlier calls, is small (:mod:`.cost`);
+* a model with a *span* (HTSG) runs it for calls of more than :data:`SPAN_MIN_PAIRS` pairs, the same
+  way. The reference engine runs the per-pair kernel (:mod:`.reference`).
 
-Calls of more than :data:`CHUNK` pairs run instead a driver generated per kernel AND
-choice combination (:data:`SPECIAL_TEMPLATE`, lazily, cached on disk): choices as a
-constant tuple, the kernel inlined, ``p`` as a tuple, a branch-free loop over flat
-views, and the unit check as a vectorisable count of pairs outside a safe band (exact
-statistics only when that count is not zero). Its chunks run in parallel, or serially on
-the calling thread (``drive_serial``, the same loop) when numba has one thread or the call's
-work, estimated from the driver's earlier calls, is below :data:`PARALLEL_MIN_S`: a parallel
-launch costs more than a fitter's evaluation of 3000 samples. LLVM vectorises that loop where the
-kernel calls no libm function (issue 9; docs/speed.md). Kernels whose ``p`` holds a
-table (longer than :data:`MAX_TUPLE`) keep the generic driver. Fortran-ordered ``(n, 3)`` arrays
-(each component contiguous) run :data:`SOA_TEMPLATE`, the specialised loop with unit-stride
-component access, derived from :data:`SPECIAL_TEMPLATE` by a checked list of edits.
+A call that may compile (the first with its argument types) sets LLVM's options for the compile
+(:mod:`.llvm_options`). Every call returns the per-chunk squared-length statistics of the directions
+for the unit check of ``BRDF.eval`` (:mod:`.unit`).
 
-A model whose per-pair kernel holds a loop of data-dependent length (HTSG's series) cannot be
-vectorised across pairs that way; such a model may also give a *span* (``kernel_span``): the same
-scalar functions composed over a block of pairs, loop by loop, so that each loop vectorises across
-pairs. Its calls run :data:`SPAN_TEMPLATE` (:func:`run` with ``span``): the unit check, then the
-span, chunk by chunk, in parallel or serially as above, on rows or Fortran-ordered arrays alike (the
-span takes the component and pair strides); calls of at most :data:`SPAN_MIN_PAIRS` pairs run the per-pair
-kernel, which starts faster. The reference engine runs the per-pair kernel.
-
-The array functions of ``terms`` (:class:`brdfkit.engine.cache.vectorize`) run an *elementwise* driver
-generated the same way (:data:`ELEMENTWISE_TEMPLATE`): the scalar term over 1-D arrays of any stride.
+The templates and the generated modules were once part of this module: the names tests and other
+modules import from here (``CHUNK``, the templates, ``driver_for`` and its kin, ``SPAN_VECTOR_WIDTH``)
+are kept here too.
 """
 
 from __future__ import annotations
 
 import contextlib
-import importlib.util
-import math
-import os
-import re
-import sys
-import tempfile
 import threading
 import time
-from collections import Counter
 from typing import Callable
 
-import numba
 import numpy as np
 
-from ..fileio import write_text
-from .cache import cache_dir, in_cache_dir, jit
-from .evaluate import _sq_stats  # the exact length statistics, shared with the generic check
-from . import vecmath
-from .. import engine as _engine
+from . import cost, vecmath
+from .cost import _PAIR_COST, PARALLEL_MIN_S  # noqa: F401  (kept importable from here)
+from .generated import (_DRIVERS, _SERIAL, _span_key, _special_key, _stem, driver_for,  # noqa: F401
+                        elementwise_driver_for, span_driver_for, special_driver_for)
+from .llvm_options import (F32_VECTOR_WIDTH, LLVM_UNROLL_THRESHOLD, SPAN_UNROLL_THRESHOLD, SPAN_VECTOR_WIDTH,  # noqa: F401
+                           SPECIAL_INTERLEAVE, compile_options, on_avx512)
+from .precision import fits_float32
+from .templates import CHUNK, SOA_TEMPLATE, SPAN_TEMPLATE, SPECIAL_TEMPLATE, TEMPLATE  # noqa: F401
+from .threads import THREAD_SAFE_LAYERS, THREADING_LAYER
+from .unit import UNIT_TOL, _sq_stats
 
-CHUNK = 2048
 #: the specialised driver passes ``p`` as a tuple; kernels with longer ``p`` (tables) keep the generic one
 MAX_TUPLE = 64
-
-TEMPLATE = '''\
-# Generated by brdfkit.engine.driver for {module}.{name}; do not edit (rewritten when the template changes).
-import math
-import numba
-from {module} import {name} as _kernel
-
-# The kernel's own source, inlined into the loop by numba (IR inlining) rather than called:
-# LLVM's inliner leaves a big kernel out of line, and a call per pair costs ~8 % (issue 9).
-{kernel_line}
-
-CHUNK = {chunk}
-
-
-@numba.njit(cache=True, error_model="numpy", nogil=True, fastmath={FM})
-def span(wi, wo, p, c, out, lim, nrm, ch, lo, hi):
-    imin = math.inf
-    imax = -math.inf
-    omin = math.inf
-    omax = -math.inf
-    inan = 0
-    onan = 0
-    for j in range(lo, hi):
-        ax = numba.float64(wi[j, 0])
-        ay = numba.float64(wi[j, 1])
-        az = numba.float64(wi[j, 2])
-        bx = numba.float64(wo[j, 0])
-        by = numba.float64(wo[j, 1])
-        bz = numba.float64(wo[j, 2])
-        li = ax * ax + ay * ay + az * az  # squared lengths (float64): the check needs no sqrt per pair
-        lo_ = bx * bx + by * by + bz * bz
-        inan += li != li
-        onan += lo_ != lo_
-        imin = min(imin, li)
-        imax = max(imax, li)
-        omin = min(omin, lo_)
-        omax = max(omax, lo_)
-        if az > 0.0 and bz > 0.0:
-            r, g, b = kernel({F}(wi[j, 0]), {F}(wi[j, 1]), {F}(wi[j, 2]), {F}(wo[j, 0]), {F}(wo[j, 1]), {F}(wo[j, 2]), p, c)
-            out[j, 0] = min(r, lim)
-            out[j, 1] = min(g, lim)
-            out[j, 2] = min(b, lim)
-        else:
-            out[j, 0] = 0.0
-            out[j, 1] = 0.0
-            out[j, 2] = 0.0
-    nrm[ch, 0] = imin
-    nrm[ch, 1] = imax
-    nrm[ch, 2] = inan
-    nrm[ch, 3] = omin
-    nrm[ch, 4] = omax
-    nrm[ch, 5] = onan
-
-
-@numba.njit(cache=True, parallel=True, error_model="numpy", nogil=True, fastmath={FM})
-def drive(wi, wo, p, c, out, lim, nrm):
-    n = wi.shape[0]
-    nchunks = (n + CHUNK - 1) // CHUNK
-    if nchunks <= 1:
-        span(wi, wo, p, c, out, lim, nrm, 0, 0, n)
-    else:
-        for ch in numba.prange(nchunks):
-            lo = ch * CHUNK
-            span(wi, wo, p, c, out, lim, nrm, ch, lo, min(n, lo + CHUNK))
-'''
-
-SPECIAL_TEMPLATE = """\
-# Generated by brdfkit.engine.driver for {module}.{name} with choices c = {choices}; do not edit.
-# (rewritten when the template changes)
-import math
-import numba
-from {module} import {name} as _kernel
-
-# the kernel's own source, inlined into the loop (numba IR inlining), choices as constants
-{kernel_line}
-C = {choices}
-CHUNK = {chunk}
-ZERO = {F}(0.0)
-
-
-@numba.njit(cache=True, error_model="numpy", nogil=True, fastmath={FM})
-def span(wi, wo, p, out, lim, lo2, hi2, nrm, ch, lo, hi):
-    a = wi[3 * lo:3 * hi]
-    b = wo[3 * lo:3 * hi]
-    o = out[3 * lo:3 * hi]
-    bad = 0
-    for j in range(hi - lo):  # branch-free: the kernel runs on every pair, a select writes 0 below the horizon
-        ax = {F}(a[3 * j])
-        ay = {F}(a[3 * j + 1])
-        az = {F}(a[3 * j + 2])
-        bx = {F}(b[3 * j])
-        by = {F}(b[3 * j + 1])
-        bz = {F}(b[3 * j + 2])
-        li = ax * ax + ay * ay + az * az
-        lo_ = bx * bx + by * by + bz * bz
-        # pairs whose squared lengths are not safely inside the tolerance (NaN included): an integer
-        # sum, which vectorises (a float min/max reduction does not); the caller redoes exact statistics
-        bad += (li >= lo2) & (li <= hi2) & (lo_ >= lo2) & (lo_ <= hi2) == False
-        ok = (az > ZERO) & (bz > ZERO)
-        r, g, bb = kernel(ax, ay, az, bx, by, bz, p, C)
-        o[3 * j] = min(r, lim) if ok else ZERO
-        o[3 * j + 1] = min(g, lim) if ok else ZERO
-        o[3 * j + 2] = min(bb, lim) if ok else ZERO
-    nrm[ch] = bad
-
-
-@numba.njit(cache=True, parallel=True, error_model="numpy", nogil=True, fastmath={FM})
-def drive(wi, wo, p, out, lim, lo2, hi2, nrm):
-    n = wi.shape[0] // 3
-    nchunks = (n + CHUNK - 1) // CHUNK
-    for ch in numba.prange(nchunks):
-        lo = ch * CHUNK
-        span(wi, wo, p, out, lim, lo2, hi2, nrm, ch, lo, min(n, lo + CHUNK))
-
-
-@numba.njit(cache=True, error_model="numpy", nogil=True, fastmath={FM})
-def drive_serial(wi, wo, p, out, lim, lo2, hi2, nrm):
-    # the same chunks on the calling thread: no thread-pool launch (0.2-0.5 ms on workqueue)
-    n = wi.shape[0] // 3
-    nchunks = (n + CHUNK - 1) // CHUNK
-    for ch in range(nchunks):
-        lo = ch * CHUNK
-        span(wi, wo, p, out, lim, lo2, hi2, nrm, ch, lo, min(n, lo + CHUNK))
-"""
-
-
-SPAN_TEMPLATE = """\
-# Generated by brdfkit.engine.driver for the span {module}.{name}; do not edit.
-# (rewritten when the template changes)
-import numba
-from {module} import {name} as _span
-
-# the model's span, inlined: its loops are compiled (and vectorised, libmvec included) in this module
-span = numba.njit(inline="always", error_model="numpy", nogil=True)(_span.py_func)
-CHUNK = {chunk}
-
-
-@numba.njit(cache=True, error_model="numpy", nogil=True)
-def chunk(wi, wo, p, c, out, lim, lo2, hi2, nrm, ch, lo, hi, cs, ps):
-    bad = 0
-    for j in range(lo, hi):  # the unit check of the specialised drivers (a count, which vectorises)
-        ax = numba.float64(wi[j * ps])
-        ay = numba.float64(wi[cs + j * ps])
-        az = numba.float64(wi[2 * cs + j * ps])
-        bx = numba.float64(wo[j * ps])
-        by = numba.float64(wo[cs + j * ps])
-        bz = numba.float64(wo[2 * cs + j * ps])
-        li = ax * ax + ay * ay + az * az
-        lo_ = bx * bx + by * by + bz * bz
-        bad += (li >= lo2) & (li <= hi2) & (lo_ >= lo2) & (lo_ <= hi2) == False
-    nrm[ch] = bad
-    span(wi, wo, out, cs, ps, lo, hi, p, c, lim)
-
-
-@numba.njit(cache=True, parallel=True, error_model="numpy", nogil=True)
-def drive(wi, wo, p, c, out, lim, lo2, hi2, nrm, cs, ps, n):
-    nchunks = (n + CHUNK - 1) // CHUNK
-    for ch in numba.prange(nchunks):
-        lo = ch * CHUNK
-        chunk(wi, wo, p, c, out, lim, lo2, hi2, nrm, ch, lo, min(n, lo + CHUNK), cs, ps)
-
-
-@numba.njit(cache=True, error_model="numpy", nogil=True)
-def drive_serial(wi, wo, p, c, out, lim, lo2, hi2, nrm, cs, ps, n):
-    nchunks = (n + CHUNK - 1) // CHUNK
-    for ch in range(nchunks):
-        lo = ch * CHUNK
-        chunk(wi, wo, p, c, out, lim, lo2, hi2, nrm, ch, lo, min(n, lo + CHUNK), cs, ps)
-"""
-
-
-def _soa_template(src: str) -> str:
-    """:data:`SPECIAL_TEMPLATE` for Fortran-ordered ``(n, 3)`` arrays (structure of arrays: every x, then
-    every y, then every z), derived from it so that the loop stays one source: the same kernel, check
-    and stores, each component read and written at unit stride (no interleaved loads and stores). GGX
-    conductor on 2^20 pairs, float32, alternating calls on the slower 2-vCPU host: 95 against 70 M
-    evaluations/s on one thread, 152 against 108 on two (medians); float64 +8-16 %."""
-    edits = [
-        ("    a = wi[3 * lo:3 * hi]\n    b = wo[3 * lo:3 * hi]\n    o = out[3 * lo:3 * hi]\n",
-         "    N = wi.shape[0] // 3  # the flat arrays hold x[0..N), y[0..N), z[0..N)\n"
-         "    a0 = wi[lo:hi]\n    a1 = wi[N + lo:N + hi]\n    a2 = wi[2 * N + lo:2 * N + hi]\n"
-         "    b0 = wo[lo:hi]\n    b1 = wo[N + lo:N + hi]\n    b2 = wo[2 * N + lo:2 * N + hi]\n"
-         "    o0 = out[lo:hi]\n    o1 = out[N + lo:N + hi]\n    o2 = out[2 * N + lo:2 * N + hi]\n"),
-        ("a[3 * j])", "a0[j])"), ("a[3 * j + 1])", "a1[j])"), ("a[3 * j + 2])", "a2[j])"),
-        ("b[3 * j])", "b0[j])"), ("b[3 * j + 1])", "b1[j])"), ("b[3 * j + 2])", "b2[j])"),
-        ("o[3 * j] =", "o0[j] ="), ("o[3 * j + 1] =", "o1[j] ="), ("o[3 * j + 2] =", "o2[j] ="),
-        ("# Generated by brdfkit.engine.driver for", "# Generated by brdfkit.engine.driver (structure of arrays) for"),
-    ]
-    for old, new in edits:
-        if src.count(old) != 1:  # pragma: no cover - the templates were edited apart
-            raise RuntimeError(f"driver: the structure-of-arrays template no longer matches {old!r}")
-        src = src.replace(old, new)
-    return src
-
-
-#: the specialised driver for Fortran-ordered ``(n, 3)`` arrays (see :func:`_soa_template`)
-SOA_TEMPLATE = _soa_template(SPECIAL_TEMPLATE)
-
-_DRIVERS: dict[tuple, Callable] = {}
-#: the serial twin (``drive_serial``) of each specialised driver, by the same key
-_SERIAL: dict[tuple, Callable] = {}
-#: a call whose work, estimated from the driver's earlier calls, is below this many seconds on one
-#: thread runs serially. Measured here (2 cores, load 0.5), serial / parallel: GGX microfacet 3000
-#: pairs 0.14 / 0.38 ms, 48 000 pairs 1.3 / 1.7 ms, 96 000 pairs 2.4 / 2.2 ms; Lambert 96 000 pairs
-#: 0.44 / 0.59 ms; HTSG 3000 pairs 4.6 / 3.1 ms: a launch on numba's workqueue layer costs ~0.2-0.5 ms
-#: (measured on workqueue, before the TBB layer became the default: not yet measured again on TBB)
-PARALLEL_MIN_S = 2e-3
-#: seconds per pair on one thread, measured on each driver's calls after its first (by key)
-_PAIR_COST: dict[tuple, float] = {}
-_LOCK = threading.Lock()
 #: one parallel launch at a time where numba's layer is workqueue (not reentrant across threads);
-#: TBB and OpenMP are thread-safe: no lock (brdfkit.engine.THREADING_LAYER)
-_RUN_LOCK = (contextlib.nullcontext() if _engine.THREADING_LAYER in ("tbb", "safe", "threadsafe", "omp")
-             else threading.Lock())
-
-
-#: LLVM's loop-vectoriser width for the float32 specialised drivers: 16 lanes (one AVX-512 register).
-#: Its cost model picks 8 for them on this CPU (interleaved (n, 3) loads), which measured half the
-#: speed of 16 (docs/speed.md); float64 keeps the cost model's choice (16 measured slower there).
-F32_VECTOR_WIDTH = 16
-#: LLVM's loop-vectoriser interleave count for the specialised drivers on a CPU with AVX-512: 2 vector
-#: iterations in flight per loop trip (0: the cost model's choice, which is 1 for these loop bodies). A
-#: pair's evaluation is one long chain of dependent operations (square roots, divisions, the exact
-#: Fresnel), so one vector iteration at a time leaves the units waiting on latency; two independent ones
-#: fill them. Measured here (one thread, 2^20 pairs, GGX conductor, medians of 6 alternating rounds,
-#: ns per pair, cost model → 2): float32 8.9 → 7.2 (row-major) and 8.1 → 7.1 (column-major), float64
-#: 29.2 → 24.0 and 25.7 → 22.2; every model, 2^19 pairs, time ratio cost model / 2: 1.07-1.38 in float32
-#: and 1.01-1.28 in float64 except Ashikhmin-Shirley and Lafortune in float32 (0.96, 0.94) and Lafortune
-#: in float64 (0.97); 3 and 4 measured no better than 2. The values are bit for bit the same (each lane
-#: still evaluates its own pair). Without AVX-512 (unmeasured) the cost model chooses.
-SPECIAL_INTERLEAVE = 2
+#: TBB and OpenMP are thread-safe: no lock (brdfkit.engine.threads)
+_RUN_LOCK = contextlib.nullcontext() if THREADING_LAYER in THREAD_SAFE_LAYERS else threading.Lock()
 #: the (driver, argument types) of the calls made so far: a call with new argument types compiles (or loads)
 #: a specialisation, for which the driver's LLVM options must be set (:func:`_compile_key`)
 _COMPILED: set = set()
+_NO_OPTIONS = contextlib.nullcontext()
 
 
 def _compile_key(drive: Callable, pt: tuple, *arrays: np.ndarray) -> tuple:
@@ -311,278 +59,23 @@ def _compile_key(drive: Callable, pt: tuple, *arrays: np.ndarray) -> tuple:
     return (drive, len(pt)) + tuple(a.dtype for a in arrays)
 
 
-#: LLVM's loop-unroll threshold while a span driver compiles: a span's loops over pairs vectorise only
-#: once the small loops of constant length inside them (HTSG's asymptotic series, 6 × up to 8 terms)
-#: are fully unrolled, which LLVM's default threshold (300 at -O3) does not do
-SPAN_UNROLL_THRESHOLD = 1000
-#: LLVM's own value of that threshold at numba's -O3, set for every other driver
-LLVM_UNROLL_THRESHOLD = 300
-
-
-@contextlib.contextmanager
-def _compile_options(width: int = 0, unroll: int = LLVM_UNROLL_THRESHOLD, interleave: int = 0):
-    """LLVM's options for a driver call that may compile: ``-force-vector-width`` and
-    ``-force-vector-interleave`` (0: the cost model's choice) and ``-unroll-threshold``. They are process-wide, so they are set while holding numba's compiler lock,
-    which every numba compile takes, and reset to LLVM's values before it is released: no compile on
-    another thread runs with this call's options, nor this one with another's. (Set outside the lock, a
-    compile waiting for it ran with the options another thread had set meanwhile, or with the defaults
-    another thread's reset had restored, and was cached so: the serial and parallel HTSG span drivers then
-    vectorised differently and differed in the last bit in full test runs.) The call runs under the lock
-    too (a driver compiles on its first call); only first calls come here."""
-    import llvmlite.binding as ll
-    from numba.core.compiler_lock import global_compiler_lock
-
-    with global_compiler_lock:
-        ll.set_option("", f"-unroll-threshold={unroll}")
-        ll.set_option("", f"-force-vector-width={width}")
-        ll.set_option("", f"-force-vector-interleave={interleave}")
-        try:
-            with (_without_llvm_remarks() if width else contextlib.nullcontext()):
-                yield
-        finally:
-            ll.set_option("", "-force-vector-width=0")
-            ll.set_option("", "-force-vector-interleave=0")
-            ll.set_option("", f"-unroll-threshold={LLVM_UNROLL_THRESHOLD}")
-
-
-@contextlib.contextmanager
-def _without_llvm_remarks():
-    """Hold back LLVM's "remark: ... loop not vectorized" lines while a forced-width driver compiles.
-
-    With ``-force-vector-width`` LLVM reports every loop it could not vectorise (those calling libm)
-    on the process's stderr, which a user of ``brdfkit eval`` would see once per driver. The C-level
-    stderr goes to a temporary file for the compile; afterwards every line that is not such a remark
-    (anything another thread wrote meanwhile) is written to stderr, so nothing else is lost."""
-    try:
-        fd = sys.__stderr__.fileno()
-    except (AttributeError, OSError, ValueError):  # pragma: no cover - no real stderr (embedded)
-        yield
-        return
-    sys.__stderr__.flush()
-    saved = os.dup(fd)
-    with tempfile.TemporaryFile() as tmp:
-        os.dup2(tmp.fileno(), fd)
-        try:
-            yield
-        finally:
-            os.dup2(saved, fd)
-            os.close(saved)
-            tmp.seek(0)
-            rest = [ln for ln in tmp.read().decode("utf-8", "replace").splitlines(True) if not ln.startswith("remark: ")]
-            if rest:
-                sys.__stderr__.write("".join(rest))
-                sys.__stderr__.flush()
+def _first_call_options(first: bool, width: int = 0, unroll: int = LLVM_UNROLL_THRESHOLD, interleave: int = 0):
+    """LLVM's options for a call that may compile (:func:`.llvm_options.compile_options`), else nothing."""
+    return compile_options(width, unroll, interleave) if first else _NO_OPTIONS
 
 
 def nchunks(n: int) -> int:
     return max(1, (n + CHUNK - 1) // CHUNK)
 
 
-def _load(key: tuple, stem: str, src: str) -> Callable:
-    d = _DRIVERS.get(key)
-    if d is not None:
-        return d
-    with _LOCK:
-        d = _DRIVERS.get(key)
-        if d is not None:
-            return d
-        folder = cache_dir() / "drivers"
-        folder.mkdir(parents=True, exist_ok=True)
-        path = folder / f"{stem}.py"
-        try:
-            current = path.read_text()
-        except OSError:
-            current = None
-        if current != src:
-            write_text(path, src)
-        modname = f"brdfkit._engine_drivers.{stem}"
-        spec = importlib.util.spec_from_file_location(modname, path)
-        mod = importlib.util.module_from_spec(spec)
-        sys.modules[modname] = mod  # first: a driver compiled (or loaded) while it executes finds its module
-        try:
-            with in_cache_dir():
-                spec.loader.exec_module(mod)
-        except BaseException:
-            del sys.modules[modname]
-            raise
-        if hasattr(mod, "drive_serial"):
-            _SERIAL[key] = mod.drive_serial
-        _DRIVERS[key] = mod.drive
-        return mod.drive
-
-
-def _ident(py) -> str:
-    """A Python function's module and name as one identifier, for a generated module's file name."""
-    return re.sub(r"[^A-Za-z0-9_]", "_", f"{py.__module__}_{py.__name__}")
-
-
-def _stem(py, f32: bool = False) -> str:
-    # drivers that call libmvec (.vecmath) have their own files: a process without it never loads one
-    return "drv_" + _ident(py) + ("__f32" if f32 else "") + ("__vm" if vecmath.available() else "")
-
-
-#: how a generated driver gets its kernel: the source itself (float64), or its float32 twin
-_KERNEL_LINE = {
-    False: 'kernel = numba.njit(inline="always", error_model="numpy", nogil=True)(_kernel.py_func)',
-    True: "from brdfkit.engine.precision import float32_twin\n"
-          "kernel = float32_twin(_kernel, inline=True)  # the same source, float32 constants",
-}
-_FTYPE = {False: "numba.float64", True: "numba.float32"}
-#: fast-math flags of the generated drivers: float32 ones FMA-contract like the twins they inline
-_FASTMATH = {False: "False", True: "{'contract'}"}
-
-
-class _Stats:
-    """numba's cache statistics summed over every driver of one kernel loaded in this process."""
-
-    def __init__(self, drivers):
-        self.cache_hits = Counter()
-        self.cache_misses = Counter()
-        for d in drivers:
-            self.cache_hits.update(d.stats.cache_hits)
-            self.cache_misses.update(d.stats.cache_misses)
-
-
-class KernelDriver:
-    """``driver_for(kernel)``: the generic ``drive`` (callable) and ``stats`` over all of the kernel's drivers."""
-
-    def __init__(self, key: tuple, drive: Callable) -> None:
-        self._key = key
-        self._drive = drive
-
-    def __call__(self, *args):
-        return self._drive(*args)
-
-    @property
-    def stats(self) -> _Stats:
-        return _Stats([d for k, d in list(_DRIVERS.items()) if k[:2] == self._key[:2]])
-
-
-_GENERIC: dict[tuple, KernelDriver] = {}
-
-
-def driver_for(kernel: Callable, f32: bool = False) -> KernelDriver:
-    """The generic compiled ``drive`` for ``kernel`` (runtime choices; generated, imported and memoised).
-
-    ``f32``: the driver of the kernel's float32 twin (:mod:`.precision`), for float32 arrays.
-    """
-    kd = _GENERIC.get((kernel, f32))
-    if kd is None:
-        py = getattr(kernel, "py_func", kernel)
-        key = (py.__module__, py.__name__, f32)
-        src = TEMPLATE.format(module=py.__module__, name=py.__name__, chunk=CHUNK,
-                              kernel_line=_KERNEL_LINE[f32], F=_FTYPE[f32], FM=_FASTMATH[f32])
-        kd = _GENERIC[(kernel, f32)] = KernelDriver(key, _load(key, _stem(py, f32), src))
-    return kd
-
-
-def _special_key(kernel: Callable, choices: tuple[int, ...], f32: bool, soa: bool = False) -> tuple:
-    """The key of a specialised driver (and of its serial twin and work estimate)."""
-    py = getattr(kernel, "py_func", kernel)
-    return (py.__module__, py.__name__, f32, choices) + (("soa",) if soa else ())
-
-
-def special_driver_for(kernel: Callable, choices: tuple[int, ...], f32: bool = False, soa: bool = False) -> Callable:
-    """The ``drive`` of ``kernel`` compiled for one combination of choice values (generated lazily, cached on disk).
-
-    ``soa``: the driver for Fortran-ordered ``(n, 3)`` arrays (:data:`SOA_TEMPLATE`).
-    """
-    py = getattr(kernel, "py_func", kernel)
-    key = _special_key(kernel, choices, f32, soa)
-    d = _DRIVERS.get(key)
-    if d is not None:
-        return d
-    src = (SOA_TEMPLATE if soa else SPECIAL_TEMPLATE).format(
-        module=py.__module__, name=py.__name__, chunk=CHUNK, choices=repr(choices),
-        kernel_line=_KERNEL_LINE[f32], F=_FTYPE[f32], FM=_FASTMATH[f32])
-    stem = _stem(py, f32) + "__c" + "_".join(str(v) for v in choices) + ("__soa" if soa else "")
-    return _load(key, stem, src)
-
-
-ELEMENTWISE_TEMPLATE = '''\
-# Generated by brdfkit.engine.driver for {module}.{name} (elementwise, {nargs} arguments); do not edit.
-import numba
-from {module} import {name} as _scalar
-
-scalar = numba.njit(inline="always", error_model="numpy", nogil=True)(_scalar.py_func)
-IN = numba.types.Array(numba.float64, 1, "A", readonly=True)  # any strides; writable arrays convert to it
-
-
-@numba.njit(numba.void({arrays}, numba.float64[::1]), cache=True, error_model="numpy", nogil=True)
-def drive({args}, out):
-    for i in range(out.shape[0]):
-        out[i] = scalar({items})
-'''
-
-
-def elementwise_driver_for(scalar: Callable, nargs: int) -> Callable:
-    """``drive(a0, …, a{nargs−1}, out)``: ``out[i] = scalar(a0[i], …)`` over 1-D float64 arrays (any strides, a
-    stride of 0 for a broadcast value; ``out`` contiguous), for :class:`brdfkit.engine.cache.vectorize`.
-
-    A generated module like the drivers, compiled for that one signature (layout ``A``) and cached on disk, so a
-    new process only loads it (3–4 ms). A numba ufunc (``numba.vectorize``, what this replaces) caches its kernel
-    but builds and compiles its wrapper anew in every process: 65–86 ms per function, measured at the first
-    call in a fresh process, three in each ``check --all`` worker that checks HTSG. Compiled without the vector math
-    library: the values are libm's, as the ufunc's were."""
-    py = getattr(scalar, "py_func", scalar)
-    key = ("elementwise", py.__module__, py.__name__, nargs)
-    d = _DRIVERS.get(key)
-    if d is not None:
-        return d
-    names = [f"a{k}" for k in range(nargs)]
-    src = ELEMENTWISE_TEMPLATE.format(module=py.__module__, name=py.__name__, nargs=nargs,
-                                      arrays=", ".join(["IN"] * nargs), args=", ".join(names),
-                                      items=", ".join(f"{n}[i]" for n in names))
-    return _load(key, "vec_" + _ident(py), src)
-
-
-#: LLVM's vector width for the span drivers where the CPU has AVX-512: 8 float64 lanes. Its cost model
-#: takes 4 (LLVM prefers 256-bit vectors there); HTSG's series set-up and terms measured 141 against
-#: 194 ns per series with 8 (random directions, aluminium defaults, one thread, this machine)
-SPAN_VECTOR_WIDTH = 8
-
-
-def _on_avx512(option: int) -> int:
-    """An LLVM option's value measured on AVX-512 (:data:`SPAN_VECTOR_WIDTH`, :data:`SPECIAL_INTERLEAVE`):
-    ``option`` on a CPU with AVX-512, else 0 (the cost model's choice)."""
-    return option if "avx512f" in vecmath.cpu_features() else 0
-
-
-def _span_key(span: Callable) -> tuple:
-    """The key of a span's driver (and of its serial twin and work estimate)."""
-    py = getattr(span, "py_func", span)
-    return ("span", py.__module__, py.__name__)
-
-
-def span_driver_for(span: Callable) -> Callable:
-    """The ``drive`` of a model's span (:data:`SPAN_TEMPLATE`; generated, imported and memoised)."""
-    py = getattr(span, "py_func", span)
-    key = _span_key(span)
-    d = _DRIVERS.get(key)
-    if d is not None:
-        return d
-    src = SPAN_TEMPLATE.format(module=py.__module__, name=py.__name__, chunk=CHUNK)
-    return _load(key, _stem(py) + "__span", src)
-
-
 #: the squared-length statistics of a call whose every direction is within the unit tolerance
 _ALL_UNIT = (1.0, 1.0, 0.0, 1.0, 1.0, 0.0)
-
-
-def _serially(key: tuple, n: int) -> tuple[bool, int]:
-    """``(serial, threads)``: whether a call of ``n`` pairs runs the serial twin of the driver ``key`` (one
-    numba thread, or work estimated from its earlier calls below :data:`PARALLEL_MIN_S`)."""
-    threads = numba.get_num_threads()
-    cost = _PAIR_COST.get(key)
-    return threads == 1 or (cost is not None and n * cost < PARALLEL_MIN_S), threads
 
 
 def _unit_band(dtype, ft) -> tuple:
     """``(lo2, hi2)``: a band of squared lengths safely inside ``|w|`` in ``[1 − tol, 1 + tol]`` (``tol`` the
     unit tolerance of the output ``dtype``), in the working precision ``ft``: the margin is far above the
     rounding of x² + y² + z² in that precision (and of the band's own rounding to it)."""
-    from .evaluate import UNIT_TOL
-
     tol = UNIT_TOL[dtype]
     margin = 1e-5 if ft is np.float32 else 1e-9
     return ft((1.0 - tol) * (1.0 - tol) * (1.0 + margin)), ft((1.0 + tol) * (1.0 + tol) * (1.0 - margin))
@@ -596,8 +89,8 @@ def _after_call(key: tuple, ck: tuple, first: bool, elapsed: float, serial: bool
     generic driver's formula) for ``check_unit`` and its message."""
     if first:
         _COMPILED.add(ck)
-    elif n > CHUNK:
-        _PAIR_COST[key] = elapsed * (1 if serial else threads) / n
+    else:
+        cost.record(key, elapsed, serial, threads, n)
     if not bad.any():
         nrm[:] = _ALL_UNIT
     else:
@@ -619,7 +112,7 @@ def _run_span(span: Callable, wi: np.ndarray, wo: np.ndarray, p: np.ndarray, c: 
     nrm = np.empty((nchunks(n), 6), dtype=np.float64)
     drive = span_driver_for(span)
     key = _span_key(span)
-    serial, threads = _serially(key, n)
+    serial, threads = cost.serially(key, n)
     serial = serial or n <= CHUNK
     if serial:
         drive = _SERIAL[key]
@@ -632,7 +125,7 @@ def _run_span(span: Callable, wi: np.ndarray, wo: np.ndarray, p: np.ndarray, c: 
     flat = (lambda x: x.T.reshape(-1)) if soa else (lambda x: x.reshape(-1))
     cs, ps = (n, 1) if soa else (1, 3)
     lock = contextlib.nullcontext() if serial else _RUN_LOCK
-    with lock, (_compile_options(_on_avx512(SPAN_VECTOR_WIDTH), SPAN_UNROLL_THRESHOLD) if first else contextlib.nullcontext()), \
+    with lock, _first_call_options(first, on_avx512(SPAN_VECTOR_WIDTH), SPAN_UNROLL_THRESHOLD), \
             vecmath.compiling():
         t0 = time.perf_counter()
         drive(flat(wi), flat(wo), pt, c, flat(out), lim, lo2, hi2, bad, cs, ps, n)
@@ -700,8 +193,6 @@ def run(kernel: Callable, wi: np.ndarray, wo: np.ndarray, p: np.ndarray, c: np.n
     if span is not None and n > SPAN_MIN_PAIRS:
         return _run_span(span, wi, wo, p, c, out, soa)
     if f32 and out.dtype == np.float32:
-        from .precision import fits_float32
-
         f32 = fits_float32(p)  # parameters outside float32's normal range: computed in float64
     else:
         f32 = False
@@ -722,7 +213,7 @@ def run(kernel: Callable, wi: np.ndarray, wo: np.ndarray, p: np.ndarray, c: np.n
     choices = tuple(int(v) for v in c)
     drive = special_driver_for(kernel, choices, f32, soa)
     key = _special_key(kernel, choices, f32, soa)
-    serial, threads = _serially(key, n)
+    serial, threads = cost.serially(key, n)
     if serial:
         drive = _SERIAL[key]
     lo2, hi2 = _unit_band(out.dtype, ft)
@@ -731,7 +222,7 @@ def run(kernel: Callable, wi: np.ndarray, wo: np.ndarray, p: np.ndarray, c: np.n
     ck = _compile_key(drive, pt, wi, wo)
     first = ck not in _COMPILED  # this call may compile (or load) a specialisation of the driver
     lock = contextlib.nullcontext() if serial else _RUN_LOCK  # a serial call launches no thread pool
-    with lock, (_compile_options(F32_VECTOR_WIDTH if f32 else 0, interleave=_on_avx512(SPECIAL_INTERLEAVE)) if first else contextlib.nullcontext()), \
+    with lock, _first_call_options(first, F32_VECTOR_WIDTH if f32 else 0, interleave=on_avx512(SPECIAL_INTERLEAVE)), \
             vecmath.compiling():
         t0 = time.perf_counter()
         if soa:  # the transposes of Fortran-ordered (n, 3) arrays are C-contiguous: flat views, no copy
@@ -743,5 +234,5 @@ def run(kernel: Callable, wi: np.ndarray, wo: np.ndarray, p: np.ndarray, c: np.n
 
 
 __all__ = ["CHUNK", "PARALLEL_MIN_S", "TEMPLATE", "SPECIAL_TEMPLATE", "SOA_TEMPLATE", "SPAN_TEMPLATE", "driver_for",
-           "special_driver_for", "span_driver_for",
+           "special_driver_for", "span_driver_for", "elementwise_driver_for",
            "param_tuple", "read_only", "run", "runs_soa", "nchunks"]

@@ -20,13 +20,15 @@ linked into the driver's and optimised there again) is edited twice, as text:
 Only functions libmvec exports for an instruction set this CPU has are named. A libmvec function is
 accurate to 4 ulp (glibc's manual, "Errors in Math Functions"; measured in ``tests/test_vecmath.py``)
 where libm's is < 1 ulp: far inside the engine's 1e-12 parity with the reference engine. Drivers
-compiled so have their own cache files (``driver._stem``), so a process with vector math off
+compiled so have their own cache files (``generated._stem``), so a process with vector math off
 (``BRDFKIT_VECTOR_MATH=0``, or no libmvec) never loads one.
 
-The hook wraps numba's ``CPUCodeLibrary._optimize_final_module`` (numba 0.6x): it acts only inside
-:func:`compiling`, on the compiling thread, on the drivers' modules; any other numba compile in the
-process is unchanged.
-Where numba lacks that method, vector math is off and the drivers are as before.
+The hook wraps numba's ``CPUCodeLibrary._optimize_final_module`` and edits the library's
+``_final_module`` (internals of numba 0.6x, tested on 0.68): it acts only inside :func:`compiling`, on
+the compiling thread, on the drivers' modules; any other numba compile in the process is unchanged.
+Where numba lacks that class or method, or an edit fails (a numba whose library has changed), vector
+math is off for the process — the drivers as without libmvec: the same values to libm's rounding, only
+slower — with one :class:`RuntimeWarning` (:func:`brdfkit.engine.notes.note_once`).
 """
 
 from __future__ import annotations
@@ -183,7 +185,7 @@ def compiling(scope: str = "drivers") -> _Compiling:
     """A context: numba compiles on this thread meanwhile call libmvec (where LLVM vectorises).
 
     ``scope="drivers"`` (the engine's): only the generated drivers' own code modules, whose
-    cache files are apart (``driver._stem``); the terms they call, compiled meanwhile, stay as
+    cache files are apart (``generated._stem``); the terms they call, compiled meanwhile, stay as
     numba writes them (their cache is shared with processes that have vector math off), and
     are vectorised inside the driver, where their code is linked in and optimised again.
     ``scope="all"``: every module compiled meanwhile (tests, experiments).
@@ -245,23 +247,60 @@ def _replace(library, edit) -> None:
         library._final_module = mod
 
 
-def _install_hook() -> bool:
-    from numba.core import codegen
+def _hook_owner():
+    """numba's ``CPUCodeLibrary`` (an internal of ``numba.core.codegen``), or None where this numba lacks it."""
+    try:
+        from numba.core import codegen
+    except ImportError:  # pragma: no cover - numba reorganised
+        return None
+    return getattr(codegen, "CPUCodeLibrary", None)
 
-    cls = getattr(codegen, "CPUCodeLibrary", None)
+
+def _turn_off(reason: str) -> None:
+    """Vector math off for the rest of the process (drivers compiled from now on call libm), said once."""
+    global _installed
+    _installed = False
+    from .notes import note_once
+
+    note_once("vecmath", f"vector math (libmvec) off: {reason}; the drivers compute the same values with libm, "
+                         "possibly slower")
+
+
+def _edited(library, edit) -> bool:
+    """``edit`` applied to ``library``'s final module (:func:`_replace`); on any failure vector math goes off."""
+    try:
+        _replace(library, edit)
+        return True
+    except Exception as exc:  # a numba whose library differs, or an edit LLVM rejects: libm instead
+        _turn_off(f"editing numba's module failed ({type(exc).__name__}: {exc})")
+        return False
+
+
+def _applies_safely(library) -> bool:
+    """:func:`_applies`, False (and vector math off) where numba's library lacks what it reads."""
+    if not _installed:
+        return False
+    try:
+        return _applies(library)
+    except Exception as exc:
+        _turn_off(f"reading numba's module failed ({type(exc).__name__}: {exc})")
+        return False
+
+
+def _install_hook() -> bool:
+    cls = _hook_owner()
     original = getattr(cls, "_optimize_final_module", None)
-    if original is None:  # pragma: no cover - a numba without this method: vector math stays off
+    if original is None:  # a numba without this class or method: vector math stays off
+        _turn_off("this numba has no CPUCodeLibrary._optimize_final_module to hook")
         return False
     if getattr(original, "_brdfkit_vecmath", False):
         return True
 
     def _optimize_final_module(self):
-        on = _applies(self)
-        if on:
-            _replace(self, annotate)
+        on = _applies_safely(self) and _edited(self, annotate)
         original(self)
         if on:
-            _replace(self, rewrite)
+            _edited(self, rewrite)
 
     _optimize_final_module._brdfkit_vecmath = True
     cls._optimize_final_module = _optimize_final_module
