@@ -84,7 +84,7 @@ from math import comb, factorial
 import numpy as np
 
 from ..engine import jit, select, vectorize
-from ..engine.driver import SPAN_VECTOR_WIDTH
+from ..engine.llvm_options import SPAN_VECTOR_WIDTH
 from .special import (
     HALF_LN_2PI,
     LN_FACT_TIMES_M,
