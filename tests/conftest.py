@@ -5,7 +5,8 @@ suite tests the same cases and a failure in CI reproduces on a developer's machi
 ``BRDFKIT_FUZZ=1`` for randomised runs (new examples each time), which is how new cases are found.
 Tests that set ``max_examples`` or ``deadline`` themselves inherit the rest from this profile.
 
-The ``server`` fixture (a live explorer server) serves the test_web_* modules.
+The ``server`` fixture (a live explorer server) serves the test_web_* modules; ``mi`` (Mitsuba 3)
+the modules that compare with Mitsuba.
 """
 
 from __future__ import annotations
@@ -32,3 +33,11 @@ def server():
     srv.shutdown()
     srv.server_close()
     thread.join(5)
+
+
+@pytest.fixture(scope="module")
+def mi():
+    """The mitsuba module in its ``scalar_rgb`` variant (skips where Mitsuba 3 is not installed)."""
+    mitsuba = pytest.importorskip("mitsuba")
+    mitsuba.set_variant("scalar_rgb")
+    return mitsuba
