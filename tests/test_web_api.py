@@ -308,3 +308,26 @@ def test_cli_serve_prints_url_and_serves():
         proc.wait(10)
         proc.stdout.close()
         proc.stderr.close()
+
+
+def test_ui_model_info_rows_and_boolean_uniform_type_per_caller():
+    """The one row builder behind /api/models and /api/brdf: booleans are `int` uniforms for the
+    registry's shaders and `bool` for a .brdf file; an infinite bound is null."""
+    from brdfkit.params import Param
+    from brdfkit.web.jsonio import ui_model_info
+
+    class Stub:
+        spec = [Param("s", "scalar", 1.0, range=(-math.inf, 2.0), log_scale=False, open_hi=True),
+                Param("b", "bool", True)]
+
+        @classmethod
+        def info(cls):
+            return {"params": [p.as_row() for p in cls.spec]}
+
+    rows = ui_model_info(Stub, glsl.GLSL_TYPES)["params"]
+    assert rows[0]["min"] is None and rows[0]["max"] == 2.0
+    assert (rows[0]["log_scale"], rows[0]["open_lo"], rows[0]["open_hi"]) == (False, False, True)
+    assert rows[0]["uniform"] == {"name": "u_s", "type": "float"}
+    assert rows[1]["uniform"] == {"name": "u_b", "type": "int"}
+    rows = ui_model_info(Stub, {**glsl.GLSL_TYPES, "bool": "bool"})["params"]
+    assert rows[1]["uniform"] == {"name": "u_b", "type": "bool"}
