@@ -6,12 +6,13 @@ suite tests the same cases and a failure in CI reproduces on a developer's machi
 Tests that set ``max_examples`` or ``deadline`` themselves inherit the rest from this profile.
 
 The ``server`` fixture (a live explorer server) serves the test_web_* modules; ``mi`` (Mitsuba 3)
-the modules that compare with Mitsuba.
+the modules that compare with Mitsuba; ``cli`` runs ``brdfkit ARGS...`` in-process.
 """
 
 from __future__ import annotations
 
 import os
+from typing import NamedTuple
 
 import pytest
 from hypothesis import settings
@@ -41,3 +42,26 @@ def mi():
     mitsuba = pytest.importorskip("mitsuba")
     mitsuba.set_variant("scalar_rgb")
     return mitsuba
+
+
+class CliRun(NamedTuple):
+    """What an in-process ``brdfkit`` run gave: unpacks as ``rc, out, err``."""
+
+    returncode: int
+    stdout: str
+    stderr: str
+
+
+@pytest.fixture
+def cli(capsys):
+    """``brdfkit ARGS...`` in-process (brdfkit.cli.main): a :class:`CliRun`. The subprocess path is
+    tested in test_measured_merl."""
+    from brdfkit.cli import main
+
+    def run(*args):
+        capsys.readouterr()
+        rc = main(list(args))
+        out = capsys.readouterr()
+        return CliRun(rc, out.out, out.err)
+
+    return run
