@@ -69,3 +69,11 @@ def assert_finite_at_all_pairs(model, D: np.ndarray) -> None:
     assert f.dtype == D.dtype
     assert np.all(np.isfinite(f)) and np.all(f >= 0)
     assert np.all(f[:, -1] == 0) and np.all(f[-1, :] == 0)
+
+
+def assert_reciprocal_only_with_cosines(model, wi: np.ndarray, wo: np.ndarray, gap: float) -> None:
+    """An unnormalised lobe: f(wi, wo) and f(wo, wi) differ by more than ``gap`` of the larger,
+    yet f(wi, wo) cos θi = f(wo, wi) cos θo (to 1e-13)."""
+    f, g = model.eval(wi, wo)[0], model.eval(wo, wi)[0]
+    assert abs(f - g) > gap * max(f, g)
+    assert math.isclose(f * wi[2], g * wo[2], rel_tol=1e-13)
