@@ -49,3 +49,31 @@ def albedo(model, wi: np.ndarray, n_mu: int = 400, n_phi: int = 800) -> np.ndarr
     dirs, w = hemisphere_grid(n_mu, n_phi)
     f = model.eval(np.asarray(wi, dtype=np.float64)[None, :], dirs)
     return (w[:, None] * f).sum(axis=0)
+
+
+def special_directions(dtype) -> np.ndarray:
+    """Directions where a formula may divide by ~0: the normal, three grazing ones (z = the dtype's
+    smallest normal-sized number), two mirror-symmetric ones, one a hair off the normal, and,
+    last, one straight below the horizon."""
+    g = 1e-300 if dtype == np.float64 else 1e-38
+    return np.array(
+        [[0, 0, 1], [1, 0, g], [-1, 0, g], [0, 1, g], [0.6, 0, 0.8], [-0.6, 0, 0.8], [1e-20, 0, 1], [0, 0, -1]],
+        dtype=dtype,
+    )
+
+
+def assert_finite_at_all_pairs(model, D: np.ndarray) -> None:
+    """f over every pair of ``D`` keeps D's dtype, is finite and ≥ 0, and is 0 wherever either
+    direction is the last of ``D`` (one on or below the horizon)."""
+    f = model.eval(D[:, None, :], D[None, :, :])
+    assert f.dtype == D.dtype
+    assert np.all(np.isfinite(f)) and np.all(f >= 0)
+    assert np.all(f[:, -1] == 0) and np.all(f[-1, :] == 0)
+
+
+def assert_reciprocal_only_with_cosines(model, wi: np.ndarray, wo: np.ndarray, gap: float) -> None:
+    """An unnormalised lobe: f(wi, wo) and f(wo, wi) differ by more than ``gap`` of the larger,
+    yet f(wi, wo) cos θi = f(wo, wi) cos θo (to 1e-13)."""
+    f, g = model.eval(wi, wo)[0], model.eval(wo, wi)[0]
+    assert abs(f - g) > gap * max(f, g)
+    assert math.isclose(f * wi[2], g * wo[2], rel_tol=1e-13)

@@ -23,22 +23,11 @@ import pytest
 import brdfkit as bk
 from brdfkit.interchange.brdf_explorer import BrdfShader, parse_brdf_text
 from brdfkit.render.glsl import compile_source, common_source, has_shader, parity_vectors, shader_source
+from _numeric_helpers import float32_spread, lifted_pairs
 
 DATA = Path(__file__).parent / "data"
 F0 = [0.95, 0.64, 0.54]
 KD = [0.1, 0.2, 0.3]
-
-
-def _spread(model, wi, wo) -> np.ndarray:
-    """Largest change of the float64 value when the inputs move by up to 4 float32 ulps."""
-    f = model.eval(wi, wo)
-    rng = np.random.default_rng(11)
-    out = np.zeros_like(f)
-    for _ in range(4):
-        di = 1 + rng.uniform(-4, 4, wi.shape) * 2.0**-24
-        do = 1 + rng.uniform(-4, 4, wo.shape) * 2.0**-24
-        out = np.maximum(out, np.abs(model.eval(wi * di, wo * do) - f))
-    return out
 
 
 def _vectors():
@@ -81,7 +70,7 @@ def test_brdf_file_equals_our_model(fname, given, ours):
     want = ref.eval(wi.astype(np.float64), wo.astype(np.float64))
     assert got.dtype == np.float64 and got.shape == want.shape
     assert np.isfinite(got).all() and (got >= 0).all()
-    spread = _spread(ref, wi.astype(np.float64), wo.astype(np.float64))
+    spread = float32_spread(ref, wi.astype(np.float64), wo.astype(np.float64), seed=11)
     err = np.abs(got - want) - (1e-4 * np.abs(want) + 1e-6 + 2 * spread)
     worst = int(np.argmax(err.max(axis=-1)))
     assert err.max() <= 0, f"{fname}: worst at {kind[worst]} wi={wi[worst]} wo={wo[worst]}: {got[worst]} vs {want[worst]}"
@@ -253,13 +242,7 @@ def test_wrapper_passes_L_wi_V_wo_and_the_local_frame():
         "}\n::end shader\n"
     )
     m = model_class(parse_brdf_text(text, name="frame.brdf"))()
-    rng = np.random.default_rng(3)
-    wi = rng.normal(size=(200, 3))
-    wo = rng.normal(size=(200, 3))
-    wi[:, 2] = np.abs(wi[:, 2]) + 0.05
-    wo[:, 2] = np.abs(wo[:, 2]) + 0.05
-    wi /= np.linalg.norm(wi, axis=1, keepdims=True)
-    wo /= np.linalg.norm(wo, axis=1, keepdims=True)
+    wi, wo = lifted_pairs(200, seed=3, lift=0.05)
     want = np.stack([wi[:, 0] + 2, wi[:, 1] + 2, 10 * wo[:, 2] + wo[:, 0] + 2], axis=1)
     np.testing.assert_allclose(m.eval(wi, wo), want, rtol=1e-6)
 
@@ -330,7 +313,7 @@ def test_glsl_es_source_evaluates_as_our_model(fname, given, ours):
     wi, wo, _ = _vectors()
     got = eval_glsl(m, wi, wo, version="300 es", source=common_source() + es).astype(np.float64)
     want = ref.eval(wi.astype(np.float64), wo.astype(np.float64))
-    spread = _spread(ref, wi.astype(np.float64), wo.astype(np.float64))
+    spread = float32_spread(ref, wi.astype(np.float64), wo.astype(np.float64), seed=11)
     assert (np.abs(got - want) <= 1e-4 * np.abs(want) + 1e-6 + 2 * spread).all()
 
 

@@ -65,6 +65,7 @@ import pytest
 
 import brdfkit as bk
 from brdfkit.render import glsl
+from _numeric_helpers import float32_spread
 
 RTOL = 1e-4
 ATOL = 1e-12
@@ -211,20 +212,6 @@ def _float32_params(model):
     return m
 
 
-def _spread(model64, wi32, wo32) -> np.ndarray:
-    """Largest change of the float64 value when the inputs move by up to 4 float32 ulps."""
-    wi = wi32.astype(np.float64)
-    wo = wo32.astype(np.float64)
-    f = model64.eval(wi, wo)
-    rng = np.random.default_rng(7)
-    out = np.zeros_like(f)
-    for _ in range(4):
-        di = 1 + rng.uniform(-4, 4, wi.shape) * 2.0**-24
-        do = 1 + rng.uniform(-4, 4, wo.shape) * 2.0**-24
-        out = np.maximum(out, np.abs(model64.eval(wi * di, wo * do) - f))
-    return out
-
-
 def assert_parity(model, wi, wo, kinds, version="330 core", source=None):
     g = glsl.eval_glsl(model, wi, wo, version=version, source=source)
     n = model.eval(wi, wo)
@@ -237,7 +224,7 @@ def assert_parity(model, wi, wo, kinds, version="330 core", source=None):
     model64 = _float32_params(model)
     n64 = model64.eval(wi.astype(np.float64), wo.astype(np.float64))
     g64 = g.astype(np.float64)
-    slack = ATOL + 2.0 * _spread(model64, wi, wo)
+    slack = ATOL + 2.0 * float32_spread(model64, wi.astype(np.float64), wo.astype(np.float64), seed=7)
     err32, err64 = np.abs(g64 - n32), np.abs(g64 - n64)
     tol32, tol64 = RTOL * np.abs(n32) + slack, RTOL * np.abs(n64) + slack
     bad = (err32 > tol32) & (err64 > tol64)

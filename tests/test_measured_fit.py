@@ -11,6 +11,7 @@ from brdfkit import registry
 from brdfkit.measured import fit as F
 from brdfkit.models.base import BRDF
 from brdfkit.params import Param
+from _fit_helpers import Bright
 
 
 class _GGXSchlickLambert(BRDF):
@@ -71,13 +72,6 @@ def test_fixed_parameters_are_held_and_json_has_every_parameter():
 
 def test_parameters_stay_within_spec_bounds():
     # data brighter than any allowed lambert: kd = 1.6 is outside [0, 1]
-    class Bright(BRDF):
-        name = "bright"
-        spec = ()
-
-        def _eval(self, wi, wo, p):
-            return np.full(wi.shape, 1.6 / np.pi)
-
     r = F.fit("lambert", Bright(), samples=500, starts=2)
     assert np.all(r.params["kd"] <= 1.0) and np.all(r.params["kd"] >= 0.999)
 
@@ -134,32 +128,13 @@ def test_recovers_microfacet_ggx_schlick():
     np.testing.assert_allclose(r.params["f0"], truth_params["f0"], rtol=0.05)
 
 
-class _Run:
-    def __init__(self, returncode, stdout, stderr):
-        self.returncode, self.stdout, self.stderr = returncode, stdout, stderr
-
-
-@pytest.fixture
-def _cli(capsys):
-    """Run the CLI in-process (brdfkit.cli.main); the subprocess path is tested in test_measured_merl."""
-    from brdfkit.cli import main
-
-    def run(*args):
-        capsys.readouterr()
-        rc = main(list(args))
-        out = capsys.readouterr()
-        return _Run(rc, out.out, out.err)
-
-    return run
-
-
-def test_cli_fit_json_and_fixed(_cli):
-    r = _cli("fit", "merl/blue-acrylic", "--model", "lambert", "--json", "--samples", "500", "--starts", "2")
+def test_cli_fit_json_and_fixed(cli):
+    r = cli("fit", "merl/blue-acrylic", "--model", "lambert", "--json", "--samples", "500", "--starts", "2")
     assert r.returncode == 0, r.stderr
     out = json.loads(r.stdout)
     assert set(out) >= {"params", "error", "metric"}
     assert out["metric"] == "ngan" and len(out["params"]["kd"]) == 3 and out["error"] > 0
-    r = _cli("fit", "merl/blue-acrylic", "-m", "lambert", "-p", "kd=0.3", "--json", "--samples", "300")
+    r = cli("fit", "merl/blue-acrylic", "-m", "lambert", "-p", "kd=0.3", "--json", "--samples", "300")
     assert json.loads(r.stdout)["params"]["kd"] == [0.3, 0.3, 0.3]
 
 
@@ -174,22 +149,22 @@ def test_cli_fit_json_and_fixed(_cli):
         (("fit", "--all-measured", "--set", "xx", "-m", "lambert"), "unknown measured set"),
     ],
 )
-def test_cli_errors_are_one_line(_cli, args, words):
-    r = _cli(*args)
+def test_cli_errors_are_one_line(cli, args, words):
+    r = cli(*args)
     assert r.returncode != 0
     assert words in r.stderr and "Traceback" not in r.stderr
     assert len(r.stderr.strip().splitlines()) == 1
 
 
-def test_cli_report_and_small_batch(_cli, tmp_path):
+def test_cli_report_and_small_batch(cli, tmp_path):
     rep = tmp_path / "rep"
-    r = _cli("fit", "nielsen/bluebook", "-m", "lambert", "--samples", "400", "--starts", "1", "--report", str(rep))
+    r = cli("fit", "nielsen/bluebook", "-m", "lambert", "--samples", "400", "--starts", "1", "--report", str(rep))
     assert r.returncode == 0, r.stderr
     for f in ("slices.png", "spheres.png", "fit.json", "index.md"):
         assert (rep / f).stat().st_size > 100
     assert (rep / "spheres.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     out = tmp_path / "batch"
-    r = _cli("fit", "--all-measured", "--set", "nielsen", "--limit", "3", "-m", "lambert",
+    r = cli("fit", "--all-measured", "--set", "nielsen", "--limit", "3", "-m", "lambert",
              "--samples", "300", "--starts", "1", "--out", str(out))
     assert r.returncode == 0, r.stderr
     rows = (out / "fit_errors.csv").read_text().strip().splitlines()
@@ -198,8 +173,8 @@ def test_cli_report_and_small_batch(_cli, tmp_path):
     assert (out / "fit_errors_sorted.png").exists() and "| material | lambert |" in (out / "fit_errors.md").read_text()
 
 
-def test_cli_list_measured(_cli):
-    r = _cli("list", "--measured", "--json")
+def test_cli_list_measured(cli):
+    r = cli("list", "--measured", "--json")
     assert r.returncode == 0, r.stderr
     names = json.loads(r.stdout)
     assert len(names) == 159 and "merl/chrome" in names and "nielsen/bluebook" in names

@@ -14,20 +14,6 @@ from brdfkit.measured import fit as F
 SUBNORMAL = 5e-324  # the smallest positive float, as a kd pressed against its bound of 0 can end
 
 
-@pytest.fixture
-def cli(capsys):
-    """``brdfkit ARGS...`` in-process: ``(exit status, stdout, stderr)``."""
-    from brdfkit.cli import main
-
-    def run(*args):
-        capsys.readouterr()
-        rc = main(list(args))
-        out = capsys.readouterr()
-        return rc, out.out, out.err
-
-    return run
-
-
 def test_text_output_starts_with_the_result_line(cli):
     rc, out, err = cli("fit", "merl/blue-acrylic", "-m", "lambert", "--samples", "300", "--starts", "1")
     assert rc == 0, err

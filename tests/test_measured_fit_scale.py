@@ -8,7 +8,7 @@ import pytest
 import brdfkit as bk
 from brdfkit.measured import fit as F
 from brdfkit.measured.merl import RES_PHI_D, RES_THETA_D, RES_THETA_H
-from brdfkit.models.base import BRDF
+from _fit_helpers import Bright
 
 
 def test_table_is_every_measured_bin_within_80_degrees(tmp_path):
@@ -76,13 +76,6 @@ def test_lobes_2_recovers_a_two_lobe_material_that_one_lobe_cannot():
 
 
 def test_at_bound_names_the_values_on_a_bound():
-    class Bright(BRDF):
-        name = "bright"
-        spec = ()
-
-        def _eval(self, wi, wo, p):
-            return np.full(wi.shape, 1.6 / np.pi)
-
     r = bk.fit("lambert", Bright(), samples=300, starts=1)
     assert r.at_bound == ["kd[0]=hi", "kd[1]=hi", "kd[2]=hi"] and r.to_json()["at_bound"] == r.at_bound
     ok = bk.fit("lambert", bk.model("lambert", kd=0.5), samples=300, starts=1)

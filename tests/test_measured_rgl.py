@@ -24,6 +24,7 @@ from brdfkit.cli import main
 from brdfkit.measured import cie
 from brdfkit.measured.rgl import RGLBRDF, load_rgl, spectral_to_rgb_matrix
 from brdfkit.measured.tensor_file import read_tensor_file, tensor_file_bytes, write_tensor_file
+from _mitsuba_helpers import mitsuba_f_r
 
 RTOL, ATOL = 1e-4, 1e-7
 
@@ -72,28 +73,12 @@ def write(tmp_path, name, **kw) -> str:
 
 
 # ----------------------------------------------------------------- Mitsuba 3
-@pytest.fixture(scope="module")
-def mi():
-    mitsuba = pytest.importorskip("mitsuba")
-    mitsuba.set_variant("scalar_rgb")
-    return mitsuba
-
-
 def mitsuba_eval(mi, path, wi, wo, *, swap=False):
-    """Mitsuba's f_r: its si.wi is brdfkit's wo, it evaluates towards brdfkit's wi and includes
-    that direction's cosine. ``swap``: the other (wrong) naming, for the sensitivity check."""
+    """Mitsuba's f_r of the file at ``path`` (brdfkit's naming). ``swap``: the other (wrong)
+    naming, for the sensitivity check."""
     if swap:
         wi, wo = wo, wi
-    bsdf = mi.load_dict({"type": "measured", "filename": path})
-    ctx = mi.BSDFContext()
-    out = np.empty((len(wi), 3))
-    for j, (a, b) in enumerate(zip(wi, wo)):
-        si = mi.SurfaceInteraction3f()
-        si.sh_frame = mi.Frame3f(mi.Vector3f(1, 0, 0), mi.Vector3f(0, 1, 0), mi.Vector3f(0, 0, 1))
-        si.wi = mi.Vector3f(*map(float, b))
-        v = bsdf.eval(ctx, si, mi.Vector3f(*map(float, a)))
-        out[j] = [v[0], v[1], v[2]]
-    return out / wi[:, 2:]
+    return mitsuba_f_r(mi, {"type": "measured", "filename": path}, wi, wo)
 
 
 #: isotropic cases first: Mitsuba 3.9 reads an uninitialised m_reduction for isotropic files,

@@ -10,6 +10,8 @@ from numpy.polynomial.legendre import leggauss
 
 import brdfkit as bk
 from brdfkit.geometry import random_unit_vectors, reflect
+from _mitsuba_helpers import mitsuba_f_r
+from _numeric_helpers import lifted_pairs
 
 DISTS = ("beckmann", "ggx")
 SHADOWS = ("smith", "smith-correlated", "v-groove")
@@ -247,31 +249,15 @@ def test_anisotropy_axis_is_tangent():
 
 
 def _mitsuba_eval(mi, dist, ax, ay, eta, k, wi, wo):
-    """Mitsuba's roughconductor f_r: its si.wi is our wo; eval(wo=our wi) includes cos θ of our wi."""
-    bsdf = mi.load_dict({
+    """Mitsuba's roughconductor f_r (brdfkit's naming; see _mitsuba_helpers.mitsuba_f_r)."""
+    return mitsuba_f_r(mi, {
         "type": "roughconductor", "distribution": dist, "alpha_u": ax, "alpha_v": ay,
         "eta": {"type": "rgb", "value": list(map(float, eta))},
         "k": {"type": "rgb", "value": list(map(float, k))},
-    })
-    ctx = mi.BSDFContext()
-    out = np.empty((len(wi), 3))
-    for j, (a, b) in enumerate(zip(wi, wo)):
-        si = mi.SurfaceInteraction3f()
-        si.sh_frame = mi.Frame3f(mi.Vector3f(1, 0, 0), mi.Vector3f(0, 1, 0), mi.Vector3f(0, 0, 1))
-        si.wi = mi.Vector3f(*map(float, b))
-        v = bsdf.eval(ctx, si, mi.Vector3f(*map(float, a)))
-        out[j] = [v[0] / a[2], v[1] / a[2], v[2] / a[2]]
-    return out
+    }, wi, wo)
 
 
 MI_CASES = [(0.3, 0.3), (0.05, 0.05), (0.8, 0.8), (0.1, 0.5), (0.6, 0.15)]  # (alpha_u along +x, alpha_v)
-
-
-@pytest.fixture(scope="module")
-def mi():
-    mitsuba = pytest.importorskip("mitsuba")
-    mitsuba.set_variant("scalar_rgb")
-    return mitsuba
 
 
 def _mi_setup(seed):
@@ -326,13 +312,7 @@ def test_active_params_leave_out_exactly_what_changes_nothing(fresnel):
     """A parameter missing from active_params() must not change eval; every rgb one kept must."""
     import brdfkit as bk
 
-    rng = np.random.default_rng(3)
-    wi = rng.normal(size=(200, 3))
-    wo = rng.normal(size=(200, 3))
-    wi[:, 2] = np.abs(wi[:, 2]) + 0.1
-    wo[:, 2] = np.abs(wo[:, 2]) + 0.1
-    wi /= np.linalg.norm(wi, axis=1, keepdims=True)
-    wo /= np.linalg.norm(wo, axis=1, keepdims=True)
+    wi, wo = lifted_pairs(200, seed=3, lift=0.1)
     m = bk.model("microfacet", fresnel=fresnel, eta=1.7, k=2.0, f0=0.3)
     base = m.eval(wi, wo)
     active = m.active_params()

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import brdfkit as bk
-from _classic_helpers import random_upper, rotate_z, vec
+from _classic_helpers import assert_finite_at_all_pairs, random_upper, rotate_z, special_directions, vec
 
 PI = math.pi
 
@@ -126,17 +126,10 @@ def test_full_negative_bracket_is_clamped_to_zero():
 @pytest.mark.parametrize("variant", ["qualitative", "full"])
 @pytest.mark.parametrize("dtype", [np.float64, np.float32])
 def test_special_directions_are_finite_and_non_negative(variant, dtype):
-    g = 1e-300 if dtype == np.float64 else 1e-38
-    D = np.array(
-        [[0, 0, 1], [1, 0, g], [-1, 0, g], [0, 1, g], [0.6, 0, 0.8], [-0.6, 0, 0.8], [1e-20, 0, 1], [0, 0, -1]],
-        dtype=dtype,
-    )
+    D = special_directions(dtype)
     for sigma in (0.0, 0.5, 1.5707):
         m = bk.model("oren-nayar", kd=1.0, sigma=sigma, variant=variant)
-        f = m.eval(D[:, None, :], D[None, :, :])
-        assert f.dtype == dtype
-        assert np.all(np.isfinite(f)) and np.all(f >= 0)
-        assert np.all(f[:, -1] == 0) and np.all(f[-1, :] == 0)
+        assert_finite_at_all_pairs(m, D)
 
 
 def test_sigma_range():

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import brdfkit as bk
-from _classic_helpers import albedo, random_upper, rotate_z, vec
+from _classic_helpers import albedo, assert_finite_at_all_pairs, random_upper, rotate_z, special_directions, vec
 
 
 def _slab_by_hand(wi, wo, C, r, p):
@@ -134,17 +134,10 @@ def test_albedo_overshoots_at_grazing_for_small_roughness():
 @pytest.mark.parametrize("layers", ["single", "double"])
 @pytest.mark.parametrize("dtype", [np.float64, np.float32])
 def test_special_directions_are_finite_and_non_negative(layers, dtype):
-    g = 1e-300 if dtype == np.float64 else 1e-38
-    D = np.array(
-        [[0, 0, 1], [1, 0, g], [-1, 0, g], [0, 1, g], [0.6, 0, 0.8], [-0.6, 0, 0.8], [1e-20, 0, 1], [0, 0, -1]],
-        dtype=dtype,
-    )
+    D = special_directions(dtype)
     for r, p in ((1e-6, 1e-6), (1.0, 1.0), (0.5, 1e-6), (1e-6, 1.0)):
         m = bk.model("schlick", layers=layers, color=1.0, r=r, p=p, color2=1.0, r2=r, p2=p)
-        f = m.eval(D[:, None, :], D[None, :, :])
-        assert f.dtype == dtype
-        assert np.all(np.isfinite(f)) and np.all(f >= 0)
-        assert np.all(f[:, -1] == 0) and np.all(f[-1, :] == 0)
+        assert_finite_at_all_pairs(m, D)
 
 
 # --- formula audit: S, Z, G and the glossy product pinned at a hand-worked point ---------------

@@ -10,7 +10,6 @@ import math
 import os
 import subprocess
 import sys
-import urllib.error
 import urllib.request
 from pathlib import Path
 from urllib.parse import quote, urlencode
@@ -20,31 +19,19 @@ import pytest
 
 import brdfkit as bk
 from brdfkit.render import glsl
-from brdfkit.web import STATIC_DIR, make_server, start_in_thread
+from brdfkit.web import STATIC_DIR, make_server
 
-
-@pytest.fixture(scope="module")
-def server():
-    srv, thread = start_in_thread("127.0.0.1", 0)
-    yield srv
-    srv.shutdown()
-    srv.server_close()
-    thread.join(5)
+from _web_helpers import get_json as _get_json
+from _web_helpers import request
 
 
 def get(srv, path: str):
     """(status, content type, body bytes) of GET path."""
-    try:
-        with urllib.request.urlopen(srv.url.rstrip("/") + path, timeout=30) as r:
-            return r.status, r.headers.get("Content-Type", ""), r.read()
-    except urllib.error.HTTPError as e:
-        return e.code, e.headers.get("Content-Type", ""), e.read()
+    return request(srv, path, timeout=30)
 
 
 def get_json(srv, path: str):
-    status, ctype, body = get(srv, path)
-    assert ctype.startswith("application/json"), (path, ctype)
-    return status, json.loads(body)
+    return _get_json(srv, path, timeout=30)
 
 
 def eval_url(model: str, params=None, wi=None, wo=None, **extra) -> str:
@@ -321,3 +308,26 @@ def test_cli_serve_prints_url_and_serves():
         proc.wait(10)
         proc.stdout.close()
         proc.stderr.close()
+
+
+def test_ui_model_info_rows_and_boolean_uniform_type_per_caller():
+    """The one row builder behind /api/models and /api/brdf: booleans are `int` uniforms for the
+    registry's shaders and `bool` for a .brdf file; an infinite bound is null."""
+    from brdfkit.params import Param
+    from brdfkit.web.jsonio import ui_model_info
+
+    class Stub:
+        spec = [Param("s", "scalar", 1.0, range=(-math.inf, 2.0), log_scale=False, open_hi=True),
+                Param("b", "bool", True)]
+
+        @classmethod
+        def info(cls):
+            return {"params": [p.as_row() for p in cls.spec]}
+
+    rows = ui_model_info(Stub, glsl.GLSL_TYPES)["params"]
+    assert rows[0]["min"] is None and rows[0]["max"] == 2.0
+    assert (rows[0]["log_scale"], rows[0]["open_lo"], rows[0]["open_hi"]) == (False, False, True)
+    assert rows[0]["uniform"] == {"name": "u_s", "type": "float"}
+    assert rows[1]["uniform"] == {"name": "u_b", "type": "int"}
+    rows = ui_model_info(Stub, {**glsl.GLSL_TYPES, "bool": "bool"})["params"]
+    assert rows[1]["uniform"] == {"name": "u_b", "type": "bool"}

@@ -10,8 +10,6 @@ bk.load_merl, the fixed-function table, validation answers, the engine's albedo;
 from __future__ import annotations
 
 import json
-import urllib.error
-import urllib.request
 from urllib.parse import urlencode
 
 import numpy as np
@@ -21,31 +19,8 @@ import brdfkit as bk
 from brdfkit import opengl
 from brdfkit.measured import nbrdf
 from brdfkit.render import glsl, meshes
-from brdfkit.web import start_in_thread
 
-
-@pytest.fixture(scope="module")
-def server():
-    srv, thread = start_in_thread("127.0.0.1", 0)
-    yield srv
-    srv.shutdown()
-    srv.server_close()
-    thread.join(5)
-
-
-def request(srv, path, body=None):
-    req = urllib.request.Request(srv.url.rstrip("/") + path, data=body, method="POST" if body is not None else "GET")
-    try:
-        with urllib.request.urlopen(req, timeout=120) as r:
-            return r.status, r.headers.get("Content-Type", ""), r.read()
-    except urllib.error.HTTPError as e:
-        return e.code, e.headers.get("Content-Type", ""), e.read()
-
-
-def get_json(srv, path, body=None):
-    status, ctype, data = request(srv, path, body)
-    assert ctype.startswith("application/json"), (path, ctype, data[:200])
-    return status, json.loads(data)
+from _web_helpers import get_json, request
 
 
 def test_measured_list_and_weights(server):

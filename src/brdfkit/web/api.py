@@ -59,7 +59,7 @@ from typing import Callable
 import numpy as np
 
 from ..sources import identify, resolve
-from .jsonio import jsonable, loads
+from .jsonio import jsonable, loads, ui_model_info
 
 Handler = Callable[[dict, bytes], tuple[int, str, bytes]]
 
@@ -313,8 +313,6 @@ def _brdf_glsl_es(text: str, name: str) -> str:
 def brdf_upload(query: dict, body: bytes):
     """A ``.brdf`` file: ``{"name", "glsl" (GLSL ES 3.00 defining brdf()), "info" (its parameter table)}``."""
     _only(query, {"name"})
-    import math
-
     from ..interchange.brdf_explorer import parse_brdf_text
     from ..render import glsl
 
@@ -328,18 +326,7 @@ def brdf_upload(query: dict, body: bytes):
 
     cls = type("BrdfFile", (BrdfExplorerModel,), {"name": name, "spec": shader.params, "brdf_shader": shader})
     es = _brdf_glsl_es(text, name)
-    info = cls.info()
-    types = {"scalar": "float", "rgb": "vec3", "bool": "bool", "choice": "int", "int": "int"}
-    by_name = {p.name: p for p in cls.spec}
-    for row in info["params"]:
-        p = by_name[row["name"]]
-        row["log_scale"] = bool(p.log_scale)
-        row["open_lo"] = bool(p.open_lo)
-        row["open_hi"] = bool(p.open_hi)
-        row["uniform"] = {"name": f"u_{p.name}", "type": types.get(p.kind, "float")}
-        for k in ("min", "max"):
-            if isinstance(row.get(k), float) and not math.isfinite(row[k]):
-                row[k] = None
+    info = ui_model_info(cls, {**glsl.GLSL_TYPES, "bool": "bool"})  # a .brdf file's booleans are `uniform bool`
     return _json({"name": name, "glsl": "#version 300 es\n" + glsl.common_source() + "\n" + es, "info": jsonable(info)})
 
 

@@ -5,7 +5,8 @@ and :mod:`.api` (the extra endpoints), so that neither imports the other's priva
 * :func:`loads`: ``json.loads`` for query values, with a nesting limit
   (:func:`brdfkit.jsonsafe.nesting_exceeds`) and a one-line :class:`BadRequest`;
 * :func:`jsonable`: numpy values as plain JSON (non-finite floats as ``null``);
-* :func:`one_line`: an exception's first line.
+* :func:`one_line`: an exception's first line;
+* :func:`ui_model_info`: a model class's ``info()`` with the parameter rows the explorer's UI reads.
 """
 
 from __future__ import annotations
@@ -20,7 +21,7 @@ from ..jsonsafe import nesting_exceeds
 
 MAX_JSON_DEPTH = 8  # nesting of the JSON in a query
 
-__all__ = ["BadRequest", "MAX_JSON_DEPTH", "jsonable", "loads", "one_line"]
+__all__ = ["BadRequest", "MAX_JSON_DEPTH", "jsonable", "loads", "one_line", "ui_model_info"]
 
 
 class BadRequest(ValueError):
@@ -63,3 +64,25 @@ def jsonable(obj: Any) -> Any:
     if isinstance(obj, float) and not math.isfinite(obj):
         return None
     return obj
+
+
+def ui_model_info(cls, uniform_types: dict[str, str]) -> dict[str, Any]:
+    """``cls.info()`` with each parameter row as the explorer's UI reads it.
+
+    Each row gains ``log_scale``, ``open_lo``, ``open_hi`` (from the class's :class:`~brdfkit.params.Param`)
+    and ``uniform`` (``u_<name>`` and its GLSL type, ``uniform_types[kind]``: the registry's shaders
+    take booleans as ``int``, a ``.brdf`` file declares them ``bool``); an infinite ``min``/``max``
+    becomes ``None``. Not yet passed through :func:`jsonable`.
+    """
+    info = cls.info()
+    by_name = {p.name: p for p in cls.spec}
+    for row in info["params"]:
+        p = by_name[row["name"]]
+        row["log_scale"] = bool(p.log_scale)
+        row["open_lo"] = bool(p.open_lo)
+        row["open_hi"] = bool(p.open_hi)
+        row["uniform"] = {"name": f"u_{p.name}", "type": uniform_types[p.kind]}
+        for k in ("min", "max"):
+            if isinstance(row.get(k), float) and not math.isfinite(row[k]):
+                row[k] = None
+    return info

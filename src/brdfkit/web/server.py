@@ -60,7 +60,6 @@ HTTP
 from __future__ import annotations
 
 import json
-import math
 import mimetypes
 import queue
 import socket
@@ -74,7 +73,7 @@ from urllib.parse import parse_qs, unquote, urlsplit
 import numpy as np
 
 from .. import registry
-from .jsonio import MAX_JSON_DEPTH, BadRequest, jsonable, loads, one_line
+from .jsonio import MAX_JSON_DEPTH, BadRequest, jsonable, loads, one_line, ui_model_info
 
 STATIC_DIR = Path(__file__).resolve().with_name("static")
 MAX_PAIRS = 100_000
@@ -92,16 +91,7 @@ def models_payload() -> dict[str, Any]:
     out = []
     for name in registry.names():
         cls = registry.get(name)
-        info = cls.info()  # what bk.model_info(name) answers
-        by_name = {p.name: p for p in cls.spec}
-        for row in info["params"]:
-            p = by_name[row["name"]]
-            row["log_scale"] = bool(p.log_scale)
-            row["open_lo"] = bool(p.open_lo)
-            row["open_hi"] = bool(p.open_hi)
-            row["uniform"] = {"name": f"u_{p.name}", "type": glsl.GLSL_TYPES[p.kind]}
-            if isinstance(row.get("min"), float) and not math.isfinite(row["min"]):
-                row["min"] = None
+        info = ui_model_info(cls, glsl.GLSL_TYPES)  # what bk.model_info(name) answers, plus the UI's fields
         info["glsl"] = glsl.has_shader(cls)
         out.append(jsonable(info))
     return {"models": out}

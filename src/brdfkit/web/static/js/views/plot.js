@@ -3,6 +3,7 @@
 
 import * as store from "../store.js";
 import { showError } from "../dom.js";
+import { glCanvas } from "../gl.js";
 import { DEG, fmt } from "../numbers.js";
 import { getSetting, num } from "../settings.js";
 import { evaluateGPU } from "../brdfs.js";
@@ -151,4 +152,15 @@ export function fitTiles(canvas, count) {
   if (canvas.height !== w + LABEL_H) canvas.height = w + LABEL_H;
   const x0 = Math.floor((W - n * w) / 2);
   return Array.from({ length: n }, (_, i) => ({ x: x0 + i * w, y: 0, w, h: w }));
+}
+
+// copy each panel's tile (drawn side by side along the bottom of the GL canvas, `size` pixels square)
+// onto the view's tiles T, with label(panel) beneath in the panel's colour; keep the tiles as the view's data
+export function blitTiles(ctx, view, list, T, size, label) {
+  list.forEach((panel, i) => {
+    ctx.drawImage(glCanvas, i * size, glCanvas.height - size, size, size, T[i].x, 0, size, size);
+    ctx.fillStyle = panel.color; ctx.font = "13px system-ui, sans-serif";
+    ctx.fillText(label(panel), T[i].x + 3, size + 14, size - 6);
+  });
+  setViewData(view, { tiles: T.slice(0, list.length), models: list.map((p) => p.model) });
 }

@@ -1,12 +1,12 @@
 // The image slice: θh × θd at φd (Rusinkiewicz 1998), one tile per visible BRDF, by SLICE_MAIN.
 
 import { canvasOf } from "../dom.js";
-import { gl, glCanvas, glSize, U } from "../gl.js";
+import { gl, glSize, U } from "../gl.js";
 import { DEG, fmt, fromHalfDiff } from "../numbers.js";
 import { getSetting, num } from "../settings.js";
 import { bindMaterial, evaluateGPU, getProgram, intConstants, sourceKey } from "../brdfs.js";
 import { visiblePanels } from "../panels.js";
-import { csvFrom, evalPanels, fitTiles, reportDrawError, setViewData } from "./plot.js";
+import { blitTiles, csvFrom, evalPanels, fitTiles, reportDrawError } from "./plot.js";
 
 export function drawSlice() {
   const canvas = canvasOf("slice");
@@ -47,12 +47,7 @@ export function drawSlice() {
       gl.drawArrays(gl.TRIANGLES, 0, 3);
     } catch (e) { reportDrawError(e); }
   });
-  list.forEach((panel, i) => {
-    ctx.drawImage(glCanvas, i * size, glCanvas.height - size, size, size, T[i].x, 0, size, size);
-    ctx.fillStyle = panel.color; ctx.font = "13px system-ui, sans-serif";
-    ctx.fillText(`${panel.model}  (φd = ${fmt(num("phi-d"))}°)`, T[i].x + 3, size + 14, size - 6);
-  });
-  setViewData("slice", { tiles: T.slice(0, list.length), models: list.map((p) => p.model) });
+  blitTiles(ctx, "slice", list, T, size, (panel) => `${panel.model}  (φd = ${fmt(num("phi-d"))}°)`);
 }
 
 // the slice's numbers: f_r on a 2° grid of (θh, θd) at the current φd, one row per grid point

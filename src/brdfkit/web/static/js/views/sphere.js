@@ -1,12 +1,12 @@
 // The lit sphere: one tile per visible BRDF, ray-cast per pixel by SPHERE_MAIN, a directional light.
 
 import { canvasOf } from "../dom.js";
-import { gl, glCanvas, glSize, U } from "../gl.js";
+import { gl, glSize, U } from "../gl.js";
 import { BACKGROUND, DEG, srgbEncode } from "../numbers.js";
 import { getSetting, num } from "../settings.js";
 import { bindMaterial, getProgram, intConstants, sourceKey } from "../brdfs.js";
 import { visiblePanels } from "../panels.js";
-import { fitTiles, reportDrawError, setViewData } from "./plot.js";
+import { blitTiles, fitTiles, reportDrawError } from "./plot.js";
 
 function lightDir() {
   const th = num("light-theta") * DEG, ph = num("light-phi") * DEG;
@@ -41,10 +41,5 @@ export function drawSphere(canvasArg) {
       gl.drawArrays(gl.TRIANGLES, 0, 3);
     } catch (e) { reportDrawError(e); }
   });
-  list.forEach((panel, i) => {
-    ctx.drawImage(glCanvas, i * size, glCanvas.height - size, size, size, T[i].x, 0, size, size);
-    ctx.fillStyle = panel.color; ctx.font = "13px system-ui, sans-serif";
-    ctx.fillText(panel.model, T[i].x + 3, size + 14, size - 6);
-  });
-  setViewData("sphere", { tiles: T.slice(0, list.length), models: list.map((p) => p.model) });
+  blitTiles(ctx, "sphere", list, T, size, (panel) => panel.model);
 }
