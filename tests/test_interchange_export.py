@@ -26,7 +26,7 @@ import numpy as np
 import pytest
 
 import brdfkit as bk
-from brdfkit.interchange import export as ex
+from brdfkit.interchange import approx
 from brdfkit.interchange.targets import F82_MU, GltfPBR, OpenPBRSurface, f82_tint_fresnel
 
 DATA = Path(__file__).parent / "data"
@@ -127,7 +127,7 @@ def test_mitsuba_stated_error_is_what_mitsuba_gives(mi, tmp_path, name, params, 
     # recompute the error from Mitsuba's own values on the fitter's samples (seed 0)
     from brdfkit.measured.fit import sample
 
-    data = sample(ex._AsSamplable(m), n=3000, seed=0)
+    data = sample(approx._AsSamplable(m), n=3000, seed=0)
     theirs = _mitsuba_f(mi, mi.load_file(str(path)), data.wi, data.wo)
     d = (theirs - data.f) * data.wi[:, 2:3]
     err = math.sqrt(np.mean(data.w[:, None] * d * d))
@@ -202,7 +202,7 @@ def test_materialx_conductor_f0_from_eta_k(tmp_path):
         np.testing.assert_allclose(o["base_color"], f0, rtol=1e-5)
         assert o["specular_roughness"] == pytest.approx(math.sqrt(0.25), rel=1e-5)
     # whatever the method, the direct mapping's values are F0 and the F82 tint
-    f0_map, tint = ex.conductor_f0_f82(eta, k)
+    f0_map, tint = approx.conductor_f0_f82(eta, k)
     np.testing.assert_allclose(f0_map, f0, rtol=1e-12)
     from brdfkit.terms.fresnel import fresnel_conductor
 
@@ -214,8 +214,8 @@ def test_materialx_conductor_f0_from_eta_k(tmp_path):
     np.testing.assert_allclose(f82_tint_fresnel(np.full(3, F82_MU), f0_map, tint)[ok], f82[ok], rtol=1e-9)
     assert (f82_tint_fresnel(np.full(3, F82_MU), f0_map, tint)[~ok] < f82[~ok]).all()
     # the stated error is the OpenPBR formula's error at the written values
-    data = ex._samples(m)
-    err, _ = ex._errors(OpenPBRSurface(**r.params).eval(data.wi, data.wo), data, "ngan")
+    data = approx._samples(m)
+    err, _ = approx._errors(OpenPBRSurface(**r.params).eval(data.wi, data.wo), data, "ngan")
     assert err == pytest.approx(r.error, rel=1e-9)
 
 
@@ -224,8 +224,8 @@ def test_materialx_fitted_model(tmp_path):
     r = bk.export(m, "materialx", tmp_path / "bp.mtlx")
     assert r.method == "fit" and not r.exact and r.relative_error < 0.5
     _read_validated(tmp_path / "bp.mtlx")
-    data = ex._samples(m)
-    err, _ = ex._errors(OpenPBRSurface(**r.params).eval(data.wi, data.wo), data, "ngan")
+    data = approx._samples(m)
+    err, _ = approx._errors(OpenPBRSurface(**r.params).eval(data.wi, data.wo), data, "ngan")
     assert err == pytest.approx(r.error, rel=1e-9)
 
 
@@ -288,8 +288,8 @@ def test_gltf_fitted_and_stated_error(tmp_path):
     pbr = g.materials[0].pbrMetallicRoughness
     np.testing.assert_allclose(pbr.baseColorFactor[:3], r.params["base_color"])
     assert pbr.metallicFactor == pytest.approx(r.params["metallic"]) and pbr.roughnessFactor == pytest.approx(r.params["roughness"])
-    data = ex._samples(m)
-    err, _ = ex._errors(GltfPBR(**r.params).eval(data.wi, data.wo), data, "ngan")
+    data = approx._samples(m)
+    err, _ = approx._errors(GltfPBR(**r.params).eval(data.wi, data.wo), data, "ngan")
     assert err == pytest.approx(r.error, rel=1e-9)
 
 
