@@ -160,3 +160,15 @@ def test_example_scene_is_found_from_any_folder(tmp_path, capsys, monkeypatch):
     assert examples.path("scene.json").is_file() and examples.path("ggx.brdf").is_file()
     with pytest.raises(ValueError, match="unknown example"):
         examples.path("nope.json")
+
+
+def test_default_environment_only_on_the_glsl_backend(tmp_path):
+    """The numpy backend's environment lighting is the reference quadrature (minutes): never a default."""
+    from brdfkit.render import scene as sc
+    from brdfkit.render.lighting import uses_default_environment
+
+    parsed, _ = sc.scene_from_json({"material": {"model": "cook-torrance"}, "size": [8, 8]})
+    assert uses_default_environment(parsed, lights_given=False)
+    assert uses_default_environment(parsed, lights_given=False, backend="glsl")
+    assert not uses_default_environment(parsed, lights_given=False, backend="numpy")
+    assert not uses_default_environment(parsed, lights_given=True)

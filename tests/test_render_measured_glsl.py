@@ -215,8 +215,9 @@ def test_cli_render_measured_file_uses_glsl(tmp_path, capsys, monkeypatch):
         else:
             monkeypatch.setattr(Renderer, "_render_numpy", original)
         out = tmp_path / f"{backend}.npy"
+        # --env none: the two backends under the same point lights (the default environment is the GLSL backend's)
         rc = main(["render", "--measured", str(tmp_path / "ct.binary"), "--mesh", "sphere", "--size", "48",
-                   "--no-antialias", "--backend", backend, "-o", str(out)])
+                   "--no-antialias", "--backend", backend, "--env", "none", "-o", str(out)])
         assert rc == 0
         outs[backend] = np.load(out)
     capsys.readouterr()

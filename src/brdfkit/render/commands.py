@@ -63,8 +63,8 @@ def register(app: typer.Typer) -> None:
             None,
             "--env",
             help="image-based lighting: a built-in environment (see --list-envs) or an .exr/.hdr map; "
-            "'none' for the point lights. Default for a BRDF or measured material with phong shading "
-            "and no lights in the scene file: studio, not drawn behind the object",
+            "'none' for the point lights. Default for a BRDF or measured material with phong shading, "
+            "the GLSL backend and no lights in the scene file: studio, not drawn behind the object",
         ),
         samples: Optional[int] = typer.Option(None, "--samples", help="samples per pixel of environment lighting (default 64)"),
         list_envs: bool = typer.Option(False, "--list-envs", help="list the built-in environments and exit"),
@@ -147,7 +147,8 @@ def register(app: typer.Typer) -> None:
             obj["environment"] = {**obj["environment"], "samples": samples}
         # the look: the material's defaults, then the scene file's fields, then the flags (already in obj)
         parsed, look = sc.scene_from_json(obj, base_dir=base)
-        if env != "none" and uses_default_environment(parsed, lights_given=obj.get("lights") is not None):
+        if env != "none" and uses_default_environment(parsed, lights_given=obj.get("lights") is not None,
+                                                      backend=backend):
             default_env = {**DEFAULT_ENVIRONMENT, **({"samples": samples} if samples is not None else {})}
             parsed.environment, asked = environment_from_spec(default_env)
             parsed.samples = asked or parsed.samples
