@@ -92,9 +92,12 @@ def fon_g(sin_t, cos_t, theta):
 
 @jit
 def fon_single(r, s, mu_i, mu_o):
-    """A (1 + r s/t): the FON single-scattering lobe without ρ/π (t = max(μi, μo) if s > 0, else 1)."""
+    """A (1 + r s/t): the FON single-scattering lobe without ρ/π (t = max(μi, μo) if s > 0, else 1).
+
+    1 + r s/t ≥ 1 − r ≥ 0 in exact arithmetic (s ≥ −1, r ≤ 1); at r = 1 and wi = −wo on the
+    horizon, s rounds below −1 (−1.2e-8 in float32): floored at 0."""
     t = max(max(mu_i, mu_o), COS_FLOOR) if s > 0.0 else 1.0
-    return fon_a(r) * (1.0 + r * (s / t))
+    return fon_a(r) * max(1.0 + r * (s / t), 0.0)
 
 
 @jit

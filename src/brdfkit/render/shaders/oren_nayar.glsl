@@ -29,7 +29,7 @@ vec3 eon_brdf(vec3 wi, vec3 wo, float si, float so) {
     float A = 1.0 / (1.0 + EON_C1 * r);
     float s = wi.x * wo.x + wi.y * wo.y;
     float t = s > 0.0 ? max(max(wi.z, wo.z), 1e-6) : 1.0;
-    float single = A * (1.0 + r * (s / t));
+    float single = A * max(1.0 + r * (s / t), 0.0);  // >= 1 - r in exact arithmetic (eon.fon_single)
     float li = max(EON_C1 - eon_fon_g(si, wi.z, bk_atan2_pos(si, wi.z)) / BK_PI, 0.0);
     float lo = max(EON_C1 - eon_fon_g(so, wo.z, bk_atan2_pos(so, wo.z)) / BK_PI, 0.0);
     float shape = A * r * li * lo / (EON_C1 - EON_C2);
