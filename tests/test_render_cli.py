@@ -169,6 +169,5 @@ def test_default_environment_only_on_the_glsl_backend(tmp_path):
 
     parsed, _ = sc.scene_from_json({"material": {"model": "cook-torrance"}, "size": [8, 8]})
     assert uses_default_environment(parsed, lights_given=False)
-    assert uses_default_environment(parsed, lights_given=False, backend="glsl")
-    assert not uses_default_environment(parsed, lights_given=False, backend="numpy")
+    assert not uses_default_environment(parsed, lights_given=False, glsl=False)
     assert not uses_default_environment(parsed, lights_given=True)

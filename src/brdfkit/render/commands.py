@@ -80,6 +80,7 @@ def register(app: typer.Typer) -> None:
         from .environment import BUILTINS, environment_from_spec
         from .image import IMAGE_SUFFIXES
         from .lighting import DEFAULT_ENVIRONMENT, uses_default_environment
+        from .renderer import has_glsl
 
         if list_envs:
             if as_json:
@@ -147,8 +148,10 @@ def register(app: typer.Typer) -> None:
             obj["environment"] = {**obj["environment"], "samples": samples}
         # the look: the material's defaults, then the scene file's fields, then the flags (already in obj)
         parsed, look = sc.scene_from_json(obj, base_dir=base)
-        if env != "none" and uses_default_environment(parsed, lights_given=obj.get("lights") is not None,
-                                                      backend=backend):
+        if env != "none" and uses_default_environment(
+            parsed, lights_given=obj.get("lights") is not None,
+            glsl=backend == "glsl" or (backend == "auto" and has_glsl(parsed.material)),
+        ):
             default_env = {**DEFAULT_ENVIRONMENT, **({"samples": samples} if samples is not None else {})}
             parsed.environment, asked = environment_from_spec(default_env)
             parsed.samples = asked or parsed.samples

@@ -55,21 +55,18 @@ soft boxes show it as what it is. OpenGL fixed-function materials keep the class
 (:data:`brdfkit.render.scene.DEFAULT_LIGHTS`): environment lighting needs a BRDF."""
 
 
-def uses_default_environment(scene: Any, lights_given: bool, backend: str = "auto") -> bool:
+def uses_default_environment(scene: Any, lights_given: bool, glsl: bool = True) -> bool:
     """Whether :data:`DEFAULT_ENVIRONMENT` lights ``scene``: a BRDF material, per-pixel (phong)
     shading, neither an environment nor lights given (by the scene file or the flags), and the
-    GLSL backend. The numpy backend's environment lighting is the reference quadrature over
-    every cell of the map, minutes for a small image: asked for by name (``--env``), never by
-    default, so ``--backend numpy`` keeps the point lights."""
-    from .renderer import has_glsl
-
+    GLSL backend (``glsl``). The numpy backend's environment lighting is the reference quadrature
+    over every cell of the map, minutes for a small image: asked for by name (``--env``), never
+    by default, so ``--backend numpy`` keeps the point lights."""
     return (
         not scene.is_opengl
         and scene.environment is None
         and not lights_given
         and scene.shading == "phong"
-        and backend != "numpy"
-        and has_glsl(scene.material)
+        and glsl
     )
 
 
