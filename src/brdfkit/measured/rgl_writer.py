@@ -190,9 +190,9 @@ def power_iteration_ndf(model, resolution: int = 64, isotropic: bool = True) -> 
     """Step 2 of the module docstring: the NDF (and σ) of ``model`` from its backscattering."""
     h, w = (2, resolution) if isotropic else (resolution, resolution)
     nodes = backscatter_nodes(h, w, isotropic)
-    flat = _clamp_up(nodes.reshape(-1, 3), 1e-3)
-    b = luminance(_evaluate(model, flat, flat)).reshape(h, w)
-    weight = np.maximum(b, 0.0) * nodes[..., 2]  # cos θ · b
+    flat = _clamp_up(nodes.reshape(-1, 3), 1e-3)  # the horizon's nodes just above it
+    b = luminance(_evaluate(model, flat, flat))
+    weight = (np.maximum(b, 0.0) * flat[:, 2]).reshape(h, w)  # cos θ · b
     if not (weight > 0).any():
         raise ValueError("the model reflects nothing back towards any direction (its backscattering is 0): "
                          "an NDF cannot be derived from it")
