@@ -21,7 +21,7 @@ import pytest
 import brdfkit as bk
 from brdfkit.measured import rgl_writer
 from brdfkit.measured.rgl import _Params, _Warp, load_rgl
-from brdfkit.measured.tabulate import tabulation_error
+from brdfkit.measured.tabulation import tabulation_error
 from brdfkit.models.base import BRDF
 from _mitsuba_helpers import mitsuba_f_r
 

@@ -82,8 +82,8 @@ def fit(name: str, measured, fixed=None, metric: str = "ngan", **kw):
 def tabulate(source, path, format=None, **kw):
     """Write any model as a MERL ``.binary`` or RGL ``.bsdf`` file (``format`` "merl" or "rgl", else
     told by the suffix); returns what was written and its tabulation error.
-    See :mod:`brdfkit.measured.tabulate`."""
-    from .measured.tabulate import tabulate as _f
+    See :mod:`brdfkit.measured.tabulation`."""
+    from .measured.tabulation import tabulate as _f
 
     return _f(source, path, format, **kw)
 

@@ -145,14 +145,14 @@ def register(app: typer.Typer) -> None:
 
 def _tabulate_cmd(source, param, fmt, out, as_json, resolution, n_theta, n_phi, ndf_resolution, description):
     from ..sources import from_cli
-    from .tabulate import tabulate
+    from .tabulation import tabulate
 
     if out is None:
         raise ValueError("missing -o PATH: the file to write (.bsdf for rgl, .binary for merl)")
     kw = dict(resolution=resolution, n_theta=n_theta, n_phi=n_phi, ndf_resolution=ndf_resolution,
               description=description)
     # the request (format, options, output path) is checked before the source is read
-    from .tabulate import FORMATS, _format_of, _rgl_options
+    from .tabulation import FORMATS, _format_of, _rgl_options
     from ..fileio import check_output_path
 
     fmt = _format_of(out, fmt)

@@ -44,7 +44,7 @@ Steps (brdfkit's ``wo``, the viewer, is the direction ``v`` the tables are param
    Y (Mitsuba samples it; raised to 1e-6 of each slice's maximum so that no slice is zero).
 
 The interpolation between samples, and between the measured incident directions, is the
-tabulation error; :func:`brdfkit.measured.tabulate.tabulate` measures it.
+tabulation error; :func:`brdfkit.measured.tabulation.tabulate` measures it.
 """
 
 from __future__ import annotations
