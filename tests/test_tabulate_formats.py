@@ -214,3 +214,12 @@ def test_cli_errors_are_one_line(cli, tmp_path, args, match):
     assert r.returncode == 2
     assert r.stderr.startswith("brdfkit: error:") and match in r.stderr
     assert len(r.stderr.strip().splitlines()) == 1 and "Traceback" not in r.stderr
+
+
+def test_formats_figure_checks_its_path_first(tmp_path):
+    from brdfkit.measured import figures
+
+    with pytest.raises(ValueError, match="must end in .png"):
+        figures.write_formats_figure(str(tmp_path / "x.txt"))
+    assert figures.main([str(tmp_path / "missing" / "tree" / "x.png")]) == 2
+    assert os.listdir(tmp_path) == []
