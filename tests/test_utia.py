@@ -125,3 +125,34 @@ def test_bad_files(tmp_path, data, msg):
 def test_directory(tmp_path):
     with pytest.raises(ValueError, match="directory"):
         utia.read_utia_table(tmp_path)
+
+
+def test_sources_sniff_bin(ward_file, tmp_path):
+    from brdfkit import sources
+    from brdfkit.measured.merl import MERLBRDF
+
+    m = sources.load_measured(ward_file)
+    assert isinstance(m, utia.UTIABRDF)
+    assert isinstance(bk.model(str(ward_file)), utia.UTIABRDF)
+    merl = tmp_path / "m.bin"
+    bk.save_merl(bk.model("lambert"), merl)
+    assert isinstance(bk.model(str(merl)), MERLBRDF)
+    bad = tmp_path / "bad.bin"
+    bad.write_bytes(b"\0" * 1000)
+    with pytest.raises(ValueError):
+        bk.model(str(bad))
+
+
+def test_cli_eval_and_info(ward_file, cli):
+    import json
+
+    r = cli("eval", str(ward_file), "--wi", "30,0", "--wo", "45,180", "--json")
+    assert r.returncode == 0, r.stderr
+    m = utia.load_utia(ward_file)
+    want = m.eval_angles(np.radians(30), 0.0, np.radians(45), np.pi)
+    assert json.dumps(json.loads(r.stdout))  # valid JSON
+    assert f"{want[0]:.4g}"[:4] in r.stdout
+    bad = ward_file.parent / "short.bin"
+    bad.write_bytes(b"\0" * 1000)
+    r = cli("eval", str(bad), "--wi", "30,0", "--wo", "45,180")
+    assert r.returncode != 0 and "Traceback" not in r.stderr
