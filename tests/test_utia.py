@@ -156,3 +156,10 @@ def test_cli_eval_and_info(ward_file, cli):
     bad.write_bytes(b"\0" * 1000)
     r = cli("eval", str(bad), "--wi", "30,0", "--wo", "45,180")
     assert r.returncode != 0 and "Traceback" not in r.stderr
+
+
+def test_fit_recovers_anisotropy(ward_file):
+    # a UTIA table of an anisotropic Ward: the fit keeps alpha_x and alpha_y apart (untied)
+    r = bk.fit("ward", str(ward_file))
+    assert r.params["alpha_x"] == pytest.approx(0.25, rel=0.15)
+    assert r.params["alpha_y"] == pytest.approx(0.6, rel=0.1)
