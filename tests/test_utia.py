@@ -163,3 +163,9 @@ def test_fit_recovers_anisotropy(ward_file):
     r = bk.fit("ward", str(ward_file))
     assert r.params["alpha_x"] == pytest.approx(0.25, rel=0.15)
     assert r.params["alpha_y"] == pytest.approx(0.6, rel=0.1)
+
+
+def test_cli_info_says_anisotropic(ward_file, cli):
+    r = cli("info", str(ward_file))
+    assert r.returncode == 0, r.stderr
+    assert "(anisotropic)" in r.stdout and "UTIA" in r.stdout
