@@ -46,6 +46,10 @@ nearest lookup, or trilinear over the measured corners when a MERL model's
 material is tabulated at the MERL bin centres first, so the GLSL shows its
 MERL-grid version. :class:`TableTextures` uploads a table once per context
 and binds it to texture unit 0; :func:`eval_glsl` and the renderer do that.
+An RGL ``.bsdf`` or UTIA ``.bin`` model has its reader's own twin instead
+(``shaders/rgl.glsl``, ``shaders/utia.glsl``; its textures and ``int``
+uniforms are described once in :mod:`brdfkit.render.tables`), bound by
+:class:`TableTextures` to units 8 and up.
 
 Generated files
 ---------------
