@@ -134,3 +134,10 @@ def test_render_glsl_equals_numpy(files, which):
     assert inside.sum() > 800
     np.testing.assert_allclose(a[inside][:, :3], b[inside][:, :3], rtol=1e-4, atol=1e-5 * b[..., :3].max())
     assert a[..., :3].max() > 0.05
+
+
+@pytest.mark.skipif(not glsl.glslang_available(), reason="glslangValidator not installed (glslang-tools)")
+@pytest.mark.parametrize("shader", ["rgl.glsl", "utia.glsl"])
+@pytest.mark.parametrize("version", glsl.VERSIONS)
+def test_shaders_pass_the_reference_compiler(shader, version):
+    glsl.glslang_validate_source(glsl.common_source() + glsl.shader_file(shader), version)
