@@ -10,7 +10,8 @@ One browser for the module, a 1024x768 page. What is checked:
   θh × θd slice has its specular band at θh = 0, the GPU albedo of Lambert is kd;
 * dragging the light on the sphere moves the highlight; the URL and a JSON parameter
   file round-trip the state; bad values there are errors on the page;
-* a built-in measured material and a dropped MERL file show and evaluate like numpy;
+* a built-in measured material and a dropped MERL file show and evaluate like numpy; a dropped
+  RGL .bsdf and UTIA .bin evaluate like the Python readers and show in every view;
 * the OpenGL fixed-function model, flat / Gouraud / Phong, and the tessellation control;
 * PNG and CSV exports; the layout at 1024x768; no console error.
 
@@ -114,7 +115,7 @@ def _no_console_errors(request):
     assert new == [], new
 
 
-EXPECTED_400 = {"test_dropped_merl_file_shows_and_equals_numpy"}
+EXPECTED_400 = {"test_dropped_merl_file_shows_and_equals_numpy", "test_dropped_rgl_and_utia_files_show_and_equal_the_readers"}
 
 
 def png_rgb(data_url: str) -> np.ndarray:
@@ -655,6 +656,42 @@ def test_dropped_merl_file_shows_and_equals_numpy(page, tmp_path):
     n = page.evaluate("window.brdfkit.panels.length")
     page.set_input_files("#file-input", str(bad))
     page.wait_for_function("window.brdfkit.errors().some(e => e.includes('broken.binary'))", timeout=30_000)
+    assert page.evaluate("window.brdfkit.panels.length") == n
+
+
+def test_dropped_rgl_and_utia_files_show_and_equal_the_readers(page, tmp_path):
+    """An RGL .bsdf (anisotropic, written by bk.tabulate at low resolution) and a UTIA .bin dropped
+    on the page: the page's rgl.glsl / utia.glsl equal the Python readers to 1e-4, every view shows them."""
+    from brdfkit.measured.utia import tabulate_utia, write_utia_table
+
+    ward = bk.model("ward", alpha_x=0.1, alpha_y=0.4, kd=0.1, ks=[0.3, 0.2, 0.1])
+    bk.tabulate(ward, tmp_path / "ward-rgl.bsdf", format="rgl", resolution=16, n_theta=4, n_phi=5, ndf_resolution=16)
+    write_utia_table(tabulate_utia(ward), tmp_path / "ward-utia.bin")
+    only(page, "lambert")
+    page.set_input_files("#file-input", [str(tmp_path / "ward-rgl.bsdf"), str(tmp_path / "ward-utia.bin")])
+    page.wait_for_function("['file:ward-rgl', 'file:ward-utia'].every(m => window.brdfkit.panels.some(p => p.model === m))",
+                           timeout=60_000)
+    wi, wo = _random_pairs(300, seed=13)
+    wi, wo = wi.astype(np.float32).astype(np.float64), wo.astype(np.float32).astype(np.float64)
+    page.wait_for_function("window.brdfkit.meshReady()", timeout=30_000)
+    for label, name in (("file:ward-rgl", "ward-rgl.bsdf"), ("file:ward-utia", "ward-utia.bin")):
+        ref = bk.model(str(tmp_path / name)).eval(wi, wo)
+        _assert_close(_page_eval(page, label, {}, wi, wo), ref, label)
+        page.evaluate("(m) => window.brdfkit.panels.forEach(p => p.setVisible(p.model === m))", label)
+        page.evaluate("window.brdfkit.redraw()")
+        assert page.evaluate("window.brdfkit.data('sphere').models") == [label]
+        shots = os.environ.get("BRDFKIT_WRITE_SHOTS")  # a folder: the views as PNGs, to look at
+        for view in VIEWS:
+            img = render(page, view)
+            assert _nonblank(img), f"{label}: view {view} is blank"
+            if shots:
+                Image.fromarray(img.astype(np.uint8)).save(os.path.join(shots, f"{name}-{view}.png"))
+    # a broken file: an error on the page naming it, no new panel
+    bad = tmp_path / "broken.bsdf"
+    bad.write_bytes(b"tensor_file\0" + b"\x01" * 20)
+    n = page.evaluate("window.brdfkit.panels.length")
+    page.set_input_files("#file-input", str(bad))
+    page.wait_for_function("window.brdfkit.errors().some(e => e.includes('broken.bsdf'))", timeout=30_000)
     assert page.evaluate("window.brdfkit.panels.length") == n
 
 

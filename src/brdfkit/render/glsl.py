@@ -46,6 +46,10 @@ nearest lookup, or trilinear over the measured corners when a MERL model's
 material is tabulated at the MERL bin centres first, so the GLSL shows its
 MERL-grid version. :class:`TableTextures` uploads a table once per context
 and binds it to texture unit 0; :func:`eval_glsl` and the renderer do that.
+An RGL ``.bsdf`` or UTIA ``.bin`` model has its reader's own twin instead
+(``shaders/rgl.glsl``, ``shaders/utia.glsl``; its textures and ``int``
+uniforms are described once in :mod:`brdfkit.render.tables`), bound by
+:class:`TableTextures` to units 8 and up.
 
 Generated files
 ---------------
@@ -129,20 +133,26 @@ def _model_class(model_or_name: Any) -> type:
 
 
 def is_measured(model_or_name: Any) -> bool:
-    """Whether a model (instance or class) is a measured one (:class:`brdfkit.measured.MeasuredBRDF`)."""
+    """Whether a model (instance or class) is a measured one (:class:`brdfkit.measured.MeasuredBRDF`,
+    or another class marked ``measured``: a UTIA table)."""
     from ..measured.merl import MeasuredBRDF
 
-    if isinstance(model_or_name, type):
-        return issubclass(model_or_name, MeasuredBRDF)
-    return isinstance(model_or_name, MeasuredBRDF)
+    cls = model_or_name if isinstance(model_or_name, type) else type(model_or_name)
+    return issubclass(cls, MeasuredBRDF) or bool(getattr(cls, "measured", False))
 
 
 def shader_path(model_or_name: Any) -> Path:
     """``render/shaders/<module>.glsl`` for a model (name, instance or class); may not exist.
 
-    Every measured model (MERL table, Neural-BRDF material) shares ``measured.glsl``.
+    An RGL ``.bsdf`` or UTIA ``.bin`` model has its reader's twin (``rgl.glsl``, ``utia.glsl``:
+    :mod:`brdfkit.render.tables`); every other measured model (MERL table, Neural-BRDF material)
+    shares ``measured.glsl``.
     """
+    from .tables import format_of
+
     cls = _model_class(model_or_name)
+    if format_of(cls):
+        return SHADER_DIR / f"{format_of(cls)}.glsl"
     if is_measured(cls):
         return SHADER_DIR / "measured.glsl"
     if cls.glsl_source:  # a model that carries its own GLSL (a .brdf file); hook declared on BRDF
@@ -289,10 +299,21 @@ def table_key(model: Any) -> str:
     if key is None:
         from ..measured.merl import MERLBRDF
 
+        from .tables import format_of, table_set
+
         if isinstance(model, MERLBRDF):
             import hashlib
 
             key = "merl:" + hashlib.blake2b(np.ascontiguousarray(model.table).tobytes(), digest_size=16).hexdigest()
+        elif format_of(model):
+            import hashlib
+
+            ts = table_set(model)
+            h = hashlib.blake2b(repr(sorted(ts.ints.items())).encode(), digest_size=16)
+            for t in ts.textures:
+                h.update(repr(t.data.shape).encode())
+                h.update(t.data.tobytes())
+            key = f"{ts.format}:{h.hexdigest()}"
         elif hasattr(model, "material"):
             key = f"{type(model).__name__}:{model.material}"
         else:
@@ -350,33 +371,70 @@ class TableTextures:
         self._tex: dict[str, Any] = {}
 
     def get(self, model: Any):
+        """The model's texture (MERL grid), or for an RGL/UTIA model ``(TableSet, [textures])``."""
         key = table_key(model)
         tex = self._tex.pop(key, None)
         if tex is None:
-            import moderngl
+            from .tables import format_of
 
-            data = table_texels(model)
-            th, td, pd, _ = data.shape
-            tex = self.ctx.texture3d((pd, td, th), 4, data.tobytes(), dtype="f4")
-            tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
-            tex.repeat_x = tex.repeat_y = tex.repeat_z = False
+            if format_of(model):
+                tex = self._upload_set(model)
+            else:
+                data = table_texels(model)
+                th, td, pd, _ = data.shape
+                tex = self._texture((pd, td, th), data)
             while len(self._tex) >= self.size:
                 old = next(iter(self._tex))
-                self._tex.pop(old).release()
+                _release(self._tex.pop(old))
         self._tex[key] = tex  # most recently used last
         return tex
 
+    def _texture(self, size: tuple[int, ...], data: np.ndarray):
+        import moderngl
+
+        make = self.ctx.texture3d if len(size) == 3 else self.ctx.texture
+        tex = make(size, int(data.shape[-1]), np.ascontiguousarray(data, dtype=np.float32).tobytes(), dtype="f4")
+        tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
+        tex.repeat_x = tex.repeat_y = False
+        if len(size) == 3:
+            tex.repeat_z = False
+        return tex
+
+    def _upload_set(self, model: Any):
+        from .tables import table_set
+
+        ts = table_set(model)
+        return ts, [self._texture(t.size, t.data) for t in ts.textures]
+
     def bind(self, prog: Any, model: Any, location: int = TABLE_TEXTURE_UNIT) -> None:
-        """Upload (once) and bind ``model``'s table to texture unit ``location`` for ``prog``."""
-        self.get(model).use(location=location)
+        """Upload (once) and bind ``model``'s table to texture unit ``location`` for ``prog``
+        (an RGL/UTIA model: its textures to units :data:`brdfkit.render.tables.FIRST_UNIT` on, and its ints)."""
+        tex = self.get(model)
+        if isinstance(tex, tuple):
+            from .tables import FIRST_UNIT
+
+            ts, texs = tex
+            for k, (t, gl_tex) in enumerate(zip(ts.textures, texs)):
+                gl_tex.use(location=FIRST_UNIT + k)
+                u = prog.get(t.uniform, None)
+                if u is not None:
+                    u.value = FIRST_UNIT + k
+            set_uniforms(prog, ts.ints)
+            return
+        tex.use(location=location)
         u = prog.get(TABLE_UNIFORM, None)
         if u is not None:
             u.value = location
 
     def release(self) -> None:
         for tex in self._tex.values():
-            tex.release()
+            _release(tex)
         self._tex.clear()
+
+
+def _release(tex: Any) -> None:
+    for t in (tex[1] if isinstance(tex, tuple) else [tex]):
+        t.release()
 
 
 # ---------------------------------------------------------------------------

@@ -32,6 +32,14 @@ Endpoints (all local; nothing here reaches outside the machine):
     read with :func:`brdfkit.measured.merl.load_merl`; answers ``application/octet-stream``: the table as the
     float32 RGBA texels of ``measured.glsl``'s ``u_table`` (90×90×180×4,
     :func:`brdfkit.render.glsl.table_texels`).
+``POST /api/measured/file?name=FILE`` (body: an RGL ``.bsdf`` or a ``.bin`` file, UTIA or MERL, told by content)
+    read by :func:`brdfkit.sources.load_measured` (the readers of ``bk.model``); answers
+    ``application/octet-stream``: the textures of its GLSL twin (``rgl.glsl``, ``utia.glsl``, or
+    ``measured.glsl`` for a MERL ``.bin``) in :func:`brdfkit.render.tables.pack`'s format, the header
+    also carrying ``name``, ``title`` and ``isotropic``. A bad file: 400 and one line naming the
+    file by the name given (never a path on the server).
+``GET /api/measured/shader?format=rgl|utia``
+    GLSL ES 3.00 defining ``brdf()`` for those tables (without ``format``: the MERL table's, below).
 ``POST /api/brdf?name=FILE.brdf`` (body: a Disney BRDF Explorer ``.brdf`` file)
     parsed by :mod:`brdfkit.interchange.brdf_explorer`; ``{"name", "glsl", "info"}``: its
     GLSL ES 3.00 (``glsl_es_source``, checked there against the 3.30 original) defining
@@ -133,8 +141,9 @@ def _body(body: bytes, what: str) -> bytes:
     return body
 
 
-def _with_temp_file(body: bytes, suffix: str, fn):
-    """``fn(path)`` on the body written (atomically) to a file in a private temporary folder."""
+def _with_temp_file(body: bytes, suffix: str, fn, label: str = "the uploaded file"):
+    """``fn(path)`` on the body written (atomically) to a file in a private temporary folder;
+    an error's message names the file ``label``, never the temporary path."""
     from ..fileio import write_bytes
 
     with tempfile.TemporaryDirectory(prefix="brdfkit-web-") as d:
@@ -143,7 +152,7 @@ def _with_temp_file(body: bytes, suffix: str, fn):
         try:
             return fn(path)
         except (OSError, ValueError) as e:
-            msg = str(e).replace(path, "the uploaded file").replace(d, "")
+            msg = str(e).replace(path, label).replace(d, "")
             raise ValueError(msg.strip().splitlines()[0] if msg.strip() else type(e).__name__) from None
 
 
@@ -241,13 +250,63 @@ def nbrdf_shader(query: dict, body: bytes):
     return 200, TEXT, ("#version 300 es\n" + nbrdf_source()).encode("utf-8")
 
 
+_TABLE_SHADERS = {"merl": "measured.glsl", "rgl": "rgl.glsl", "utia": "utia.glsl"}
+
+
 @route("GET", "/api/measured/shader")
 def measured_shader(query: dict, body: bytes):
-    _only(query, set())
+    _only(query, {"format"})
     from ..render import glsl
 
-    src = glsl.common_source() + "\n" + glsl.shader_file("measured.glsl")
+    fmt = _one(query, "format", "merl")
+    if fmt not in _TABLE_SHADERS:
+        raise ValueError(f"unknown table format {fmt!r}; valid: {', '.join(_TABLE_SHADERS)}")
+    src = glsl.common_source() + "\n" + glsl.shader_file(_TABLE_SHADERS[fmt])
     return 200, TEXT, ("#version 300 es\n" + src).encode("utf-8")
+
+
+MEASURED_SUFFIXES = (".bsdf", ".bin")
+MAX_TABLE_BYTES = 512 << 20  # the textures sent back for one file
+
+
+def _read_measured_upload(data: bytes, name: str):
+    """The model of an uploaded measured file (its kind by ``name``'s suffix, a .bin by content)."""
+    from ..sources import load_measured
+
+    suffix = os.path.splitext(name)[1].lower()
+    if suffix not in MEASURED_SUFFIXES:
+        raise ValueError(f"{name}: expected an RGL .bsdf or a UTIA/MERL .bin file")
+    try:
+        return _with_temp_file(data, suffix, load_measured, label=name)
+    except ValueError:
+        raise
+    except Exception as e:  # a reader's unforeseen failure on a malformed file: still one line, never a 500
+        raise ValueError(f"{name}: not a readable {suffix} file ({type(e).__name__})") from None
+
+
+@route("POST", "/api/measured/file")
+def measured_file_upload(query: dict, body: bytes):
+    _only(query, {"name"})
+    from ..render import tables
+
+    name = os.path.basename(_one(query, "name"))[:200] or "uploaded"
+    model = _read_measured_upload(_body(body, name), name)
+    fmt = tables.format_of(model)
+    if fmt:
+        ts = tables.table_set(model)
+    else:  # a MERL .bin: measured.glsl's u_table, nearest lookup
+        from ..render import glsl
+
+        ts = tables.TableSet("merl", "measured.glsl", (tables.Texture("u_table", glsl.table_texels(model)),),
+                             {"u_interpolation": 0})
+    titles = {"rgl": "RGL .bsdf file (Dupuy & Jakob 2018), evaluated as Mitsuba 3's measured",
+              "utia": "UTIA .bin file (Filip & Vávra 2014), quadrilinear",
+              "merl": "MERL table (dropped file), nearest bin"}
+    size = sum(t.data.nbytes for t in ts.textures)
+    if size > MAX_TABLE_BYTES:
+        raise ValueError(f"{name}: its tables take {size >> 20} MiB, more than the explorer's {MAX_TABLE_BYTES >> 20} MiB")
+    return 200, "application/octet-stream", tables.pack(
+        ts, name=name, title=titles[ts.format], isotropic=bool(getattr(model, "isotropic", False)))
 
 
 @route("POST", "/api/merl")

@@ -60,6 +60,16 @@ float bk_acos(float x) {
     return x < 0.0 ? BK_PI - r : r;
 }
 
+// atan2(y, x) in [−π, π] as numpy's arctan2 away from the origin (there: 0), the sign of
+// y's zero kept (atan2(−0, x < 0) = −π); from bk_atan01: GL's atan(y, x) is 2e-5 off on llvmpipe
+float bk_atan2(float y, float x) {
+    float ax = abs(x), ay = abs(y);
+    if (ax == 0.0 && ay == 0.0) return 0.0;
+    float r = ay <= ax ? bk_atan01(ay / ax) : BK_HALF_PI - bk_atan01(ax / ay);
+    if (x < 0.0) r = BK_PI - r;
+    return (floatBitsToUint(y) >> 31) != 0u ? -r : r;
+}
+
 // complementary error function for x >= 0: the Chebyshev-fitted form of
 // Numerical Recipes (Press et al., 2nd ed., §6.2, fractional error < 1.2e-7).
 float bk_erfc_pos(float x) {

@@ -1,5 +1,5 @@
-// The BRDFs the page knows (analytic models, built-in measured materials, dropped MERL and
-// .brdf files), their GLSL programs, and evaluation on the GPU: brdf() for direction pairs
+// The BRDFs the page knows (analytic models, built-in measured materials, dropped MERL, RGL,
+// UTIA and .brdf files), their GLSL programs, and evaluation on the GPU: brdf() for direction pairs
 // read from float textures into an RGBA32F target and read back (every plot, the albedo
 // quadrature, window.brdfkit.eval).
 
@@ -11,10 +11,12 @@ import { fetchText, fetchJSON } from "./net.js";
 
 const nbrdfWeights = {};  // material -> Float32Array(844): u_nbrdf[211] of nbrdf.glsl (only this module reads them)
 
-/** "analytic" | "merl" | "brdf" | "nbrdf", or null for a name the page does not know. */
+/** "analytic" | "merl" | "table" (a dropped RGL/UTIA/.bin file) | "brdf" | "nbrdf", or null for a
+ * name the page does not know. */
 export function kindOf(name) {
   if (store.get("modelInfo")[name]) return "analytic";
   if (store.get("merlTables")[name]) return "merl";
+  if (store.get("tableFiles")[name]) return "table";
   if (store.get("brdfFiles")[name]) return "brdf";
   if (store.get("measuredNames").includes(name)) return "nbrdf";
   return null;
@@ -26,6 +28,7 @@ export function sourceKey(name) {
   if (k === "analytic") return name;
   if (k === "nbrdf") return "__nbrdf";
   if (k === "merl") return "__merl";
+  if (k === "table") return store.get("tableFiles")[name].key;
   if (k === "brdf") return store.get("brdfFiles")[name].key;
   throw new Error(`unknown BRDF '${name}'`);
 }
@@ -35,6 +38,7 @@ export function infoOf(name) {
   const k = kindOf(name);
   if (k === "analytic") return store.get("modelInfo")[name];
   if (k === "brdf") return store.get("brdfFiles")[name].info;
+  if (k === "table") return store.get("tableFiles")[name].info;
   return { name, title: k === "merl" ? "MERL table (dropped file), nearest bin" : "measured material (Neural-BRDF network)",
     reference: "", params: [] };
 }
@@ -142,6 +146,15 @@ export function bindMaterial(prog, name, params) {
     gl.bindTexture(gl.TEXTURE_3D, store.get("merlTables")[name].texture);
     gl.uniform1i(U(prog, "u_table"), 3);
     gl.uniform1i(U(prog, "u_interpolation"), 0);
+    gl.activeTexture(gl.TEXTURE0);
+  } else if (k === "table") {  // units and uniforms as the server's brdfkit.render.tables says
+    const f = store.get("tableFiles")[name];
+    for (const t of f.textures) {
+      gl.activeTexture(gl.TEXTURE0 + t.unit);
+      gl.bindTexture(t.target, t.texture);
+      gl.uniform1i(U(prog, t.uniform), t.unit);
+    }
+    for (const [u, v] of Object.entries(f.ints)) gl.uniform1i(U(prog, u), v);
     gl.activeTexture(gl.TEXTURE0);
   }
 }

@@ -1,5 +1,6 @@
-// Dropped or opened files: a MERL .binary (a table in a 3D texture), a Disney .brdf (its GLSL
-// from the server) and an .obj mesh. Their bytes survive a reload: they are kept in IndexedDB
+// Dropped or opened files: a MERL .binary (a table in a 3D texture), an RGL .bsdf or a .bin
+// (UTIA or MERL, told by the server from its content: the textures of its GLSL twin, rgl.glsl,
+// utia.glsl or measured.glsl), a Disney .brdf (its GLSL from the server) and an .obj mesh. Their bytes survive a reload: they are kept in IndexedDB
 // under their SHA-256, the state (URL, saved view) names them ({name, sha256}); a state naming
 // a file this browser no longer holds is an error on the page.
 
@@ -25,10 +26,64 @@ async function loadMerlFile(file) {
   for (const p of [gl.TEXTURE_WRAP_S, gl.TEXTURE_WRAP_T, gl.TEXTURE_WRAP_R]) gl.texParameteri(gl.TEXTURE_3D, p, gl.CLAMP_TO_EDGE);
   gl.texImage3D(gl.TEXTURE_3D, 0, gl.RGBA32F, 180, 90, 90, 0, gl.RGBA, gl.FLOAT, texels);
   const label = "file:" + file.name.replace(/\.(binary|bin)$/, "");
+  forgetTables(label);
+  store.update("merlTables", (tables) => { tables[label] = { texture: tex }; });
+  store.emit("catalog");
+  return label;
+}
+
+/** Drop a loaded table file's label from every kind of table (a file loaded again, maybe as another format). */
+function forgetTables(label) {
   store.update("merlTables", (tables) => {
-    if (tables[label]) gl.deleteTexture(tables[label].texture);
-    tables[label] = { texture: tex };
+    if (tables[label]) { gl.deleteTexture(tables[label].texture); delete tables[label]; }
   });
+  store.update("tableFiles", (files) => {
+    if (files[label]) { for (const t of files[label].textures) gl.deleteTexture(t.texture); delete files[label]; }
+  });
+}
+
+/** The header and the textures of /api/measured/file's answer (brdfkit.render.tables.pack). */
+function unpackTables(buf, fileName) {
+  const n = new DataView(buf).getUint32(0, true);
+  const head = JSON.parse(new TextDecoder().decode(new Uint8Array(buf, 4, n)));
+  if (4 + n + head.bytes !== buf.byteLength) throw new Error(`${fileName}: unexpected table size from the server`);
+  const max3d = gl.getParameter(gl.MAX_3D_TEXTURE_SIZE), max2d = gl.getParameter(gl.MAX_TEXTURE_SIZE);
+  const textures = head.textures.map((t) => {
+    const max = t.dims === 3 ? max3d : max2d;
+    if (t.size.some((s) => s > max)) throw new Error(`${fileName}: a ${t.size.join("×")} table is larger than this WebGL allows (${max} per side)`);
+    const count = t.size.reduce((a, b) => a * b, 1) * t.components;
+    return Object.assign({}, t, { data: new Float32Array(buf, 4 + n + t.offset, count) });
+  });
+  return { head, textures };
+}
+
+function tableTexture(t) {
+  const target = t.dims === 3 ? gl.TEXTURE_3D : gl.TEXTURE_2D;
+  const [ifmt, fmt] = t.components === 1 ? [gl.R32F, gl.RED] : [gl.RGBA32F, gl.RGBA];
+  const tex = gl.createTexture();
+  gl.bindTexture(target, tex);
+  for (const p of [gl.TEXTURE_MIN_FILTER, gl.TEXTURE_MAG_FILTER]) gl.texParameteri(target, p, gl.NEAREST);
+  for (const p of [gl.TEXTURE_WRAP_S, gl.TEXTURE_WRAP_T, gl.TEXTURE_WRAP_R]) gl.texParameteri(target, p, gl.CLAMP_TO_EDGE);
+  gl.pixelStorei(gl.UNPACK_ALIGNMENT, 1);
+  if (t.dims === 3) gl.texImage3D(target, 0, ifmt, t.size[0], t.size[1], t.size[2], 0, fmt, gl.FLOAT, t.data);
+  else gl.texImage2D(target, 0, ifmt, t.size[0], t.size[1], 0, fmt, gl.FLOAT, t.data);
+  gl.pixelStorei(gl.UNPACK_ALIGNMENT, 4);
+  return { uniform: t.uniform, unit: t.unit, target, texture: tex };
+}
+
+async function loadTableFile(file) {
+  const r = await fetch("/api/measured/file?name=" + encodeURIComponent(file.name),
+    { method: "POST", body: await file.arrayBuffer(), headers: { "Content-Type": "application/octet-stream" } });
+  if (!r.ok) { const b = await r.json().catch(() => ({ error: r.statusText })); throw new Error(b.error || `${file.name}: ${r.statusText}`); }
+  const { head, textures } = unpackTables(await r.arrayBuffer(), file.name);
+  const key = "__table:" + head.format;
+  const sources = store.get("sources");
+  if (sources[key] === undefined) sources[key] = await fetchText("/api/measured/shader?format=" + head.format);
+  const label = "file:" + file.name.replace(/\.(bsdf|bin)$/i, "");
+  forgetTables(label);
+  const made = textures.map(tableTexture);
+  const info = { name: label, title: head.title, reference: "", params: [], isotropic: head.isotropic };
+  store.update("tableFiles", (files) => { files[label] = { format: head.format, key, textures: made, ints: head.ints, info }; });
   store.emit("catalog");
   return label;
 }
@@ -56,9 +111,10 @@ async function loadObjFile(file) {
   return "obj";
 }
 
-const FILE_KINDS = [[/\.(binary|bin)$/i, loadMerlFile], [/\.brdf$/i, loadBrdfFile], [/\.obj$/i, loadObjFile]];
+const FILE_KINDS = [[/\.binary$/i, loadMerlFile], [/\.(bsdf|bin)$/i, loadTableFile], [/\.brdf$/i, loadBrdfFile],
+  [/\.obj$/i, loadObjFile]];
 
-/** The loader of a file name (MERL, .brdf, .obj), or null. */
+/** The loader of a file name (MERL, RGL, UTIA, .brdf, .obj), or null. */
 export const fileLoader = (name) => (FILE_KINDS.find(([re]) => re.test(name)) || [null, null])[1];
 
 let idbOpen = null;

@@ -62,7 +62,7 @@ async function openFile(file) {
       } else addPanel(label, {});
       store.changed();
     } else {
-      throw new Error(`${file.name}: unknown file type; drop a .json view, a MERL .binary, a .brdf or an .obj`);
+      throw new Error(`${file.name}: unknown file type; drop a .json view, a MERL .binary, an RGL .bsdf, a UTIA .bin, a .brdf or an .obj`);
     }
   } catch (e) { showError(e); }
 }

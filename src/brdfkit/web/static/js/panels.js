@@ -18,7 +18,7 @@ function modelOptions(select, current) {
     g1.append(el("option", { value: name, text: name + (st && !st.ok ? " (shader error)" : "") }));
   }
   select.append(g1);
-  const loaded = Object.keys(store.get("merlTables")).concat(Object.keys(store.get("brdfFiles")));
+  const loaded = Object.keys(store.get("merlTables")).concat(Object.keys(store.get("tableFiles")), Object.keys(store.get("brdfFiles")));
   if (loaded.length) {
     const g = el("optgroup", { label: "loaded files" });
     for (const n of loaded) g.append(el("option", { value: n, text: n }));

@@ -5,9 +5,10 @@
 //   status        window.brdfkitStatus: {ready, webgl2, floatTargets, renderer, models, error, frames, drawn}
 //   modelInfo     analytic model name -> its /api/models row
 //   measuredNames the built-in measured materials (["set/name", ...])
-//   sources       GLSL source key -> text (model name, "__nbrdf", "__merl", "__brdf:<label>")
+//   sources       GLSL source key -> text (model name, "__nbrdf", "__merl", "__table:<format>", "__brdf:<label>")
 //   programs      program id -> WebGLProgram, or {error}
 //   merlTables    loaded MERL label -> {texture}
+//   tableFiles    loaded RGL/UTIA/.bin label -> {format, key, textures: [{uniform, unit, target, texture}], ints, info}
 //   brdfFiles     loaded .brdf label -> {info, key}
 //   shaderFiles   render/shaders file name -> text (the pipeline's files)
 //   openglTable   /api/opengl (the fixed-function materials and light)
@@ -33,7 +34,7 @@ function initial() {
   };
   const orbit = { lobe3d: { yaw: -60, pitch: 25, zoom: 1.3 }, object: { yaw: 20, pitch: 15, zoom: 1 } };
   return {
-    status, modelInfo: {}, measuredNames: [], sources: {}, programs: {}, merlTables: {}, brdfFiles: {},
+    status, modelInfo: {}, measuredNames: [], sources: {}, programs: {}, merlTables: {}, tableFiles: {}, brdfFiles: {},
     shaderFiles: {}, openglTable: null, loadedFiles: {}, uploadedMesh: null, panels: [],
     panes: ["polar", "sphere"], orbit, defaults: {}, viewData: {},
   };

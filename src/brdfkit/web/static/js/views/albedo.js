@@ -62,7 +62,7 @@ export function drawAlbedo() {
     let d = null;
     try { d = method === "gpu" ? albedoGPU(panel) : albedoEngine(panel); } catch (e) { reportDrawError(e); }
     if (!d) { waiting++; continue; }
-    if (kindOf(panel.model) === "merl" && method !== "gpu") continue;
+    if ((kindOf(panel.model) === "merl" || kindOf(panel.model) === "table") && method !== "gpu") continue;
     xs = d.thetas;
     const f = Float32Array.from(d.rgb.flat());
     evals.push({ panel, f });
