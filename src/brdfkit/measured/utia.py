@@ -169,7 +169,10 @@ def read_utia_table(path: str | os.PathLike) -> np.ndarray:
     path = os.fspath(path)
     if os.path.isdir(path):
         raise ValueError(f"{path}: is a directory, not a UTIA .bin file")
-    size = os.path.getsize(path)  # OSError if missing
+    try:
+        size = os.path.getsize(path)
+    except OSError as e:
+        raise ValueError(f"{path}: {'no such file' if not os.path.exists(path) else e.strerror or e}") from None
     if size != FILE_BYTES:
         what = "empty" if size == 0 else ("truncated" if size < FILE_BYTES else "has trailing data")
         raise ValueError(f"{path}: {what}: {size} bytes, a UTIA .bin file has exactly {FILE_BYTES} bytes")

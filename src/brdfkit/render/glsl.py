@@ -152,9 +152,15 @@ def shader_path(model_or_name: Any) -> Path:
 
 
 def has_shader(model_or_name: Any) -> bool:
-    """Whether the model has a GLSL file (or carries its own source, ``glsl_source``)."""
+    """Whether the model has a GLSL file (or carries its own source, ``glsl_source``).
+
+    An anisotropic measured instance (an anisotropic RGL file) has none: ``measured.glsl`` reads
+    an isotropic MERL-grid table, so such a material renders on the numpy backend."""
     if _model_class(model_or_name).glsl_source:
         return True
+    if is_measured(model_or_name) and not isinstance(model_or_name, type) \
+            and not getattr(model_or_name, "isotropic", True):
+        return False
     return shader_path(model_or_name).is_file()
 
 
