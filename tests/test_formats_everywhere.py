@@ -262,3 +262,24 @@ def test_bad_file_is_one_line_at_every_command(bad, which, command, cli, tmp_pat
     r = cli(*COMMANDS[command](path, tmp_path))
     _one_error_line(r, os.path.basename(path), words)
     assert not any(tmp_path.iterdir())  # nothing written
+
+
+# ----------------------------------------------------------------- bk.tabulate(..., format="utia")
+def test_tabulate_writes_utia(files, tmp_path, cli):
+    """``format="utia"`` (or a ``.bin`` path) writes the model at the UTIA grid: the same bytes as
+    ``tabulate_utia`` + ``write_utia_table``, read back as UTIA, with its tabulation error."""
+    p = tmp_path / "w.bin"
+    r = bk.tabulate(_model(ANISO), p, error_pairs=4000)
+    assert r.format == "utia" and r.bytes == utia.FILE_BYTES
+    assert p.read_bytes() == open(files["utia"], "rb").read()
+    assert isinstance(bk.model(str(p)), utia.UTIABRDF)
+    assert 0 < r.error < 0.05, r.error  # this anisotropic Ward on the 15°/7.5° grid: 3.3 %
+    with pytest.raises(ValueError, match="applies to format 'rgl' only"):
+        bk.tabulate("lambert", tmp_path / "l.bin", resolution=16)
+    with pytest.raises(ValueError, match="must end in .bin"):
+        bk.tabulate("lambert", tmp_path / "l.bsdf", format="utia")
+    c = cli("tabulate", "lambert", "-p", "kd=0.5", "--format", "utia", "-o", str(tmp_path / "l.bin"), "--json")
+    assert c.returncode == 0, c.stderr
+    res = json.loads(c.stdout)
+    assert res["format"] == "utia" and res["error"] < 1e-12  # a constant is exact on any grid
+    np.testing.assert_allclose(bk.model(str(tmp_path / "l.bin")).eval(_vec(30, 10), _vec(70, 100)), 0.5 / np.pi)

@@ -177,7 +177,7 @@ def _tabulate_cmd(source, param, fmt, out, as_json, resolution, n_theta, n_phi, 
     from .tabulation import tabulate
 
     if out is None:
-        raise ValueError("missing -o PATH: the file to write (.bsdf for rgl, .binary for merl)")
+        raise ValueError("missing -o PATH: the file to write (.bsdf for rgl, .binary for merl, .bin for utia)")
     kw = dict(resolution=resolution, n_theta=n_theta, n_phi=n_phi, ndf_resolution=ndf_resolution,
               description=description)
     # the request (format, options, output path) is checked before the source is read
@@ -193,8 +193,8 @@ def _tabulate_cmd(source, param, fmt, out, as_json, resolution, n_theta, n_phi, 
         print_json(res.to_json())
         return
     sh = res.shape
-    size = (f"{sh['n_phi']} x {sh['n_theta']} incident directions, {sh['resolution']}^2 samples each"
-            if res.format == "rgl" else "90 x 90 x 180 bins")
+    size = {"rgl": lambda: f"{sh['n_phi']} x {sh['n_theta']} incident directions, {sh['resolution']}^2 samples each",
+            "utia": lambda: "6 x 48 x 6 x 48 angles", "merl": lambda: "90 x 90 x 180 bins"}[res.format]()
     typer.echo(f"wrote {res.path} ({res.format}, {res.bytes / 1e6:.2f} MB, {size}) in {res.seconds:.1f} s")
     if res.error is not None:
         typer.echo(f"  tabulation error {100 * res.error:.3g} % ({res.error_measure}, {res.error_pairs} pairs)")
@@ -235,8 +235,8 @@ def _register_tabulate(app: typer.Typer) -> None:
         source: str = typer.Argument(..., help="any model: a name (brdfkit list), a built-in material, "
                                                "a .brdf, a fit's .json, a MERL .binary or an RGL .bsdf file"),
         param: List[str] = typer.Option([], "--param", "-p", help="a parameter of the model: name=value (repeatable)"),
-        fmt: Optional[str] = typer.Option(None, "--format", "-f", help="merl or rgl (default: told by the suffix of -o)"),
-        out: Optional[str] = typer.Option(None, "--out", "-o", help="the file to write: .binary (merl) or .bsdf (rgl)"),
+        fmt: Optional[str] = typer.Option(None, "--format", "-f", help="merl, rgl or utia (default: told by the suffix of -o)"),
+        out: Optional[str] = typer.Option(None, "--out", "-o", help="the file to write: .binary (merl), .bsdf (rgl) or .bin (utia)"),
         as_json: bool = typer.Option(False, "--json", help="print a JSON summary (path, format, sizes, error)"),
         resolution: Optional[int] = typer.Option(None, "--resolution", help="rgl: samples per side of each table (64)"),
         n_theta: Optional[int] = typer.Option(None, "--n-theta", help="rgl: incident elevations (32)"),
@@ -245,7 +245,7 @@ def _register_tabulate(app: typer.Typer) -> None:
         ndf_resolution: Optional[int] = typer.Option(None, "--ndf-resolution", help="rgl: NDF nodes per side (64)"),
         description: Optional[str] = typer.Option(None, "--description", help="rgl: the file's description text"),
     ) -> None:
-        """Write any model as a measured file: MERL .binary or RGL .bsdf (Mitsuba 3's `measured`)."""
+        """Write any model as a measured file: MERL .binary, RGL .bsdf (Mitsuba 3's `measured`) or UTIA .bin."""
         _tabulate_cmd(source, param, fmt, out, as_json, resolution, n_theta, n_phi, ndf_resolution, description)
 
 
