@@ -283,3 +283,18 @@ def test_tabulate_writes_utia(files, tmp_path, cli):
     res = json.loads(c.stdout)
     assert res["format"] == "utia" and res["error"] < 1e-12  # a constant is exact on any grid
     np.testing.assert_allclose(bk.model(str(tmp_path / "l.bin")).eval(_vec(30, 10), _vec(70, 100)), 0.5 / np.pi)
+
+
+# ----------------------------------------------------------------- scenes
+@pytest.mark.parametrize("key", ["merl", "measured"])
+def test_scene_file_takes_measured_files_beside_it(files, key, cli, tmp_path):
+    """A scene's material may be an RGL or UTIA file, relative to the scene file's folder."""
+    for kind in ("aniso", "utia"):
+        name = os.path.basename(files[kind])
+        os.link(files[kind], tmp_path / name)
+        scene = tmp_path / f"{kind}.json"
+        scene.write_text(json.dumps({"material": {key: name}, "size": [24, 24], "mesh": "sphere"}))
+        out = tmp_path / f"{kind}-{key}.npy"
+        r = cli("render", "--scene", str(scene), "-o", str(out), "--env", "none")
+        assert r.returncode == 0, r.stderr
+        assert (np.load(out)[..., 3] > 0.5).sum() > 50
