@@ -33,9 +33,11 @@ def files(tmp_path_factory):
     """``iso.bsdf`` (GGX), ``aniso.bsdf`` (anisotropic Ward) and ``ward.bin`` (the same Ward, UTIA)."""
     d = tmp_path_factory.mktemp("formats")
     out = {"iso": str(d / "iso.bsdf"), "aniso": str(d / "aniso.bsdf"), "utia": str(d / "ward.bin")}
-    r = bk.tabulate(_model(ISO), out["iso"], format="rgl", resolution=16, n_theta=8, error_pairs=500)
+    r = bk.tabulate(_model(ISO), out["iso"], format="rgl", resolution=16, n_theta=8, ndf_resolution=32,
+                     error_pairs=500)
     assert r.error < 0.05, r.error
-    r = bk.tabulate(_model(ANISO), out["aniso"], format="rgl", resolution=16, n_theta=6, n_phi=4, error_pairs=500)
+    r = bk.tabulate(_model(ANISO), out["aniso"], format="rgl", resolution=16, n_theta=6, n_phi=4,
+                     ndf_resolution=32, error_pairs=500)
     assert r.error < 0.1 and r.shape["isotropic"] is False, (r.error, r.shape)
     utia.write_utia_table(utia.tabulate_utia(_model(ANISO)), out["utia"])
     return out
