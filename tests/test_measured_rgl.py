@@ -414,3 +414,100 @@ def test_cli_eval(tmp_path, capsys):
     np.testing.assert_allclose(got, want, rtol=1e-5)
     assert main(["eval", p, "--wi", "30,0", "--wo", "30,180", "-p", "a=1"]) != 0
     assert "takes no parameters" in capsys.readouterr().err
+
+
+# ----------------------------------------------------------------- more bad files (issue 28's list)
+def _field_offsets(raw: bytes):
+    """(name, where its ndim, dtype, offset and shape entries are) for every field of a tensor_file."""
+    n = struct.unpack_from("<I", raw, 14)[0]
+    pos, out = 18, []
+    for _ in range(n):
+        ln = struct.unpack_from("<H", raw, pos)[0]
+        name = raw[pos + 2:pos + 2 + ln].decode()
+        at = pos + 2 + ln
+        ndim = struct.unpack_from("<H", raw, at)[0]
+        out.append((name, at, at + 2, at + 3, at + 11, ndim))
+        pos = at + 11 + 8 * ndim
+    return out
+
+
+def test_offsets_and_dimension_claims_past_the_end(tmp_path):
+    good = tensor_file_bytes(rgl_fields())
+    fields = {name: rest for name, *rest in _field_offsets(good)}
+    cases = []
+    for offset in (len(good), len(good) - 3, 2**63, 2**64 - 1):
+        raw = bytearray(good)
+        struct.pack_into("<Q", raw, fields["vndf"][2], offset)
+        cases.append((raw, "'vndf' claims .* past the end"))
+    raw = bytearray(good)  # 65535 dimensions: the shape runs past the header
+    struct.pack_into("<H", raw, fields["rgb"][0], 65535)
+    cases.append((raw, "truncated tensor_file header|past the end"))
+    raw = bytearray(good)  # a shape whose product overflows 64 bits
+    for k in range(fields["rgb"][4]):
+        struct.pack_into("<Q", raw, fields["rgb"][3] + 8 * k, 2**64 - 1)
+    cases.append((raw, "'rgb' claims .* past the end"))
+    for i, (raw, match) in enumerate(cases):
+        _one_line_error(_header_mutation(None, tmp_path, f"off{i}.bsdf", bytes(raw)), match)
+
+
+@pytest.mark.parametrize("name", ["theta_i", "phi_i", "ndf", "sigma", "vndf", "luminance", "rgb"])
+@pytest.mark.parametrize("value", [np.nan, np.inf, -np.inf])
+def test_non_finite_values_in_any_table(tmp_path, name, value):
+    f = rgl_fields(n_phi=3, reduction=2)
+    f[name] = f[name].copy()
+    f[name].flat[len(f[name].ravel()) // 2] = value
+    _one_line_error(_header_mutation(f, tmp_path, "nan.bsdf"), f"'{name}' holds NaN or infinite")
+
+
+def test_spectral_non_finite_and_tables_over_the_memory_limit(tmp_path, monkeypatch):
+    from brdfkit.measured import rgl
+
+    f = rgl_fields(spectral=[450.0, 550.0, 650.0])
+    f["spectra"] = f["spectra"].copy()
+    f["spectra"][0, 0, 1, 2, 2] = np.nan
+    _one_line_error(_header_mutation(f, tmp_path, "s.bsdf"), "'spectra' holds NaN")
+    monkeypatch.setattr(rgl, "MAX_TABLE_BYTES", 10_000)  # a claim the file can hold, but not memory
+    _one_line_error(write(tmp_path, "big.bsdf"), "more than brdfkit's limit")
+
+
+@settings(max_examples=150, deadline=None, suppress_health_check=list(HealthCheck))
+@given(which=st.integers(0, 8), part=st.sampled_from(["ndim", "dtype", "offset", "shape"]),
+       value=st.one_of(st.integers(0, 16), st.sampled_from([255, 65535, 2**31, 2**32 - 1, 2**63, 2**64 - 1]),
+                       st.integers(0, 2**64 - 1)))
+def test_fuzz_header_fields(tmp_path_factory, which, part, value):
+    """Each header field (ndim, dtype code, offset, a shape entry) set to any value: a model or one
+    ValueError line, and no allocation beyond the file's size (the claims are checked first)."""
+    raw = bytearray(_GOOD)
+    name, at_ndim, at_dtype, at_offset, at_shape, ndim = _field_offsets(_GOOD)[which % len(_field_offsets(_GOOD))]
+    fmt, at = {"ndim": ("<H", at_ndim), "dtype": ("<B", at_dtype), "offset": ("<Q", at_offset),
+               "shape": ("<Q", at_shape)}[part]
+    if part == "shape" and ndim == 0:
+        return
+    struct.pack_into(fmt, raw, at, value % (1 << (8 * struct.calcsize(fmt))))
+    p = str(tmp_path_factory.mktemp("hfuzz") / "f.bsdf")
+    with open(p, "wb") as fh:
+        fh.write(bytes(raw))
+    tracemalloc.start()
+    try:
+        try:
+            m = load_rgl(p)
+        except ValueError as e:
+            assert "\n" not in str(e)
+            m = None
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak < 200 * len(_GOOD) + (4 << 20)
+    if m is not None:
+        v = m.eval(*random_pairs(50, 1))
+        assert np.isfinite(v).all() and (v >= 0).all()
+
+
+def test_cli_bad_file_is_one_line(tmp_path, capsys):
+    raw = bytearray(tensor_file_bytes(rgl_fields()))
+    struct.pack_into("<Q", raw, _field_offsets(bytes(raw))[0][4], 2_500_000_000)  # theta_i: a 10 GB claim
+    p = _header_mutation(None, tmp_path, "huge.bsdf", bytes(raw))
+    for args in (["eval", p, "--wi", "30,0", "--wo", "30,180"], ["info", p], ["fit", p, "-m", "lambert"]):
+        assert main(args) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and err[0].startswith("brdfkit: error: ") and "claims 10000000000 bytes" in err[0]

@@ -2,6 +2,8 @@
 
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 import brdfkit as bk
 from brdfkit.measured import utia
@@ -169,3 +171,62 @@ def test_cli_info_says_anisotropic(ward_file, cli):
     r = cli("info", str(ward_file))
     assert r.returncode == 0, r.stderr
     assert "(anisotropic)" in r.stdout and "UTIA" in r.stdout
+
+
+def test_missing_file_and_absurd_values(tmp_path):
+    with pytest.raises(ValueError, match="no such file"):
+        utia.read_utia_table(tmp_path / "nope.bin")
+    p = tmp_path / "huge.bin"
+    p.write_bytes(np.full(utia.SHAPE, 1e300).tobytes())
+    with pytest.raises(ValueError, match="absurd"):
+        utia.read_utia_table(p)
+    with pytest.raises(ValueError, match="absurd"):
+        utia.UTIABRDF(np.full(utia.SHAPE, 1e300))
+
+
+def test_extrapolation_never_overflows():
+    """The largest table values allowed, extrapolated above 75° (weights up to 2): clamped, finite."""
+    m = utia.UTIABRDF(np.full(utia.SHAPE, utia.MAX_VALUE))
+    v = m.eval_angles(np.radians(89.0), 0.3, np.radians(89.5), 2.0)
+    assert np.isfinite(v).all() and (v == utia.MAX_VALUE).all()
+
+
+_SPECIAL = [np.nan, np.inf, -np.inf, -1.0, -0.0, 0.0, 1e-300, 1e30, 1e300, 5e-324]
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=list(HealthCheck))
+@given(edits=st.lists(st.tuples(st.integers(0, int(np.prod(utia.SHAPE)) - 1), st.sampled_from(_SPECIAL)),
+                      max_size=4),
+       raw_edits=st.lists(st.tuples(st.integers(0, utia.FILE_BYTES - 1), st.integers(0, 255)), max_size=4),
+       length=st.one_of(st.none(), st.integers(0, utia.FILE_BYTES + 16)))
+def test_fuzz_mutated_files(tmp_path_factory, edits, raw_edits, length):
+    """Special values in the table, flipped bytes, wrong sizes: a model whose values are finite and
+    non-negative, or one ValueError line; memory bounded by the file's size."""
+    import tracemalloc
+
+    table = np.full(utia.SHAPE, 0.25).ravel()
+    for i, v in edits:
+        table[i] = v
+    raw = bytearray(table.tobytes())
+    for pos, byte in raw_edits:
+        raw[pos] = byte
+    if length is not None:
+        raw = (raw + bytes(16))[:length]
+    p = tmp_path_factory.mktemp("ufuzz") / "f.bin"
+    p.write_bytes(bytes(raw))
+    tracemalloc.start()
+    try:
+        try:
+            m = bk.model(str(p))
+        except ValueError as e:
+            assert "\n" not in str(e)
+            m = None
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak < 8 * utia.FILE_BYTES + (4 << 20)
+    if m is not None:
+        rng = np.random.default_rng(0)
+        wi, wo = (_vec(rng.uniform(0, np.pi / 2, 64), rng.uniform(0, 2 * np.pi, 64)) for _ in range(2))
+        v = m.eval(wi, wo)
+        assert np.isfinite(v).all() and (v >= 0).all()

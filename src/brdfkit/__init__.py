@@ -80,8 +80,8 @@ def fit(name: str, measured, fixed=None, metric: str = "ngan", **kw):
 
 
 def tabulate(source, path, format=None, **kw):
-    """Write any model as a MERL ``.binary`` or RGL ``.bsdf`` file (``format`` "merl" or "rgl", else
-    told by the suffix); returns what was written and its tabulation error.
+    """Write any model as a MERL ``.binary``, RGL ``.bsdf`` or UTIA ``.bin`` file (``format`` "merl",
+    "rgl" or "utia", else told by the suffix); returns what was written and its tabulation error.
     See :mod:`brdfkit.measured.tabulation`."""
     from .measured.tabulation import tabulate as _f
 

@@ -170,7 +170,7 @@ def register(app: typer.Typer) -> None:
 
     @app.command("info")
     def info(
-        model: str = typer.Argument(..., metavar="MODEL", help="Registry name (see `brdfkit list`)."),
+        model: str = typer.Argument(..., metavar="MODEL", help="A model: registry name (see `brdfkit list`), measured material, or a file (.binary, .bin, .bsdf, .brdf, a fit's .json)."),
         json_: bool = typer.Option(False, "--json", help="Print the model info as JSON."),
     ) -> None:
         """Show a model's title, reference and parameter table (or what a measured material is)."""
@@ -209,7 +209,7 @@ def register(app: typer.Typer) -> None:
 
     @app.command("eval")
     def eval_cmd(
-        model: str = typer.Argument(..., metavar="MODEL", help="Registry name (see `brdfkit list`)."),
+        model: str = typer.Argument(..., metavar="MODEL", help="A model: registry name (see `brdfkit list`), measured material, or a file (.binary, .bin, .bsdf, .brdf, a fit's .json)."),
         param: List[str] = typer.Option(
             [], "-p", "--param", metavar="NAME=VALUE", help="Parameter as name=value (number, r,g,b, true/false, choice). Repeatable."
         ),

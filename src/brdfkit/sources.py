@@ -122,7 +122,13 @@ def _build_bin(path: str, params: dict) -> BRDF:
             return load_utia(path)
     from .measured.merl import load_merl
 
-    return load_merl(path)
+    try:
+        return load_merl(path)
+    except ValueError as e:  # neither: say both, the UTIA size first (a .bin is more often UTIA)
+        size = os.path.getsize(path)
+        merl = str(e).removeprefix(f"{path}: ")
+        raise ValueError(f"{path}: not a UTIA .bin file ({size} bytes, UTIA's have exactly {FILE_BYTES}) "
+                         f"nor a MERL one ({merl})") from None
 
 
 def _build_rgl(path: str, params: dict) -> BRDF:

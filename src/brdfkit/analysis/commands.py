@@ -75,7 +75,7 @@ def _note(message: str) -> None:
 def register(app: typer.Typer) -> None:
     @app.command("check")
     def check_cmd(
-        model: Optional[str] = typer.Argument(None, help="registry name of the model (see `brdfkit list`)"),
+        model: Optional[str] = typer.Argument(None, help="a model (see `brdfkit list`), a built-in measured material or a file (.bsdf, .bin, .binary, .brdf, fit .json)"),
         param: List[str] = typer.Option([], "-p", "--param", help="parameter name=value (repeatable)"),
         all_models: bool = typer.Option(False, "--all", help="every model at its defaults and stress settings"),
         json_out: bool = typer.Option(False, "--json", help="print JSON (a list with --all)"),

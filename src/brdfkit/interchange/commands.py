@@ -26,7 +26,7 @@ def source_model(source: str, items: List[str] | None = None):
 def register(app: typer.Typer) -> None:
     @app.command("export")
     def export_cmd(
-        source: str = typer.Argument(..., help="model name, .brdf file, measured material / MERL file, or a fit's JSON"),
+        source: str = typer.Argument(..., help="model name, .brdf file, measured material or file (.binary, .bin, .bsdf), or a fit's JSON"),
         param: List[str] = typer.Option([], "--param", "-p", help="set a parameter: name=value (repeatable)"),
         to: str = typer.Option(..., "--to", help="mitsuba, materialx or gltf"),
         output: str = typer.Option(..., "--output", "-o", help="file to write: .xml/.json (mitsuba), .mtlx, .glb"),

@@ -24,6 +24,8 @@ source                                          Mitsuba BSDF                    
                                                 1 − w; reflectances rescaled)
 ``microfacet`` beckmann, smith, conductor       as above                          no: Mitsuba's Beckmann G1 is
                                                                                   Walter's rational approximation
+an RGL ``.bsdf`` file (Dupuy & Jakob 2018)      ``measured`` (its ``filename``:   yes
+                                                the file's absolute path)
 ``microfacet`` smith, dielectric, isotropic     ``roughplastic`` (the same        no: its diffuse term is
                                                 specular lobe; diffuse_reflectance Fresnel-coupled
                                                 by least squares)

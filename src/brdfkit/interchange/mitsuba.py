@@ -6,7 +6,9 @@ Which source becomes which BSDF, and when exactly: :mod:`brdfkit.interchange.exp
 
 from __future__ import annotations
 
+import os
 from typing import Any
+from xml.sax.saxutils import escape
 
 import numpy as np
 
@@ -82,7 +84,7 @@ def mitsuba_xml(d: dict[str, Any], ident: str = "material") -> str:
             return [f'{pad}<boolean name="{k}" value="{str(v).lower()}"/>']
         if isinstance(v, (int, float)):
             return [f'{pad}<float name="{k}" value="{float(v):.17g}"/>']
-        return [f'{pad}<string name="{k}" value="{v}"/>']
+        return [f'{pad}<string name="{k}" value="{escape(str(v), {chr(34): "&quot;"})}"/>']
 
     def obj(o: dict[str, Any], pad: str, name: str | None, root: bool = False) -> list[str]:
         attrs = f' version="3.0.0" type="{o["type"]}" id="{ident}"' if root else f' type="{o["type"]}"'
@@ -97,10 +99,23 @@ def mitsuba_xml(d: dict[str, Any], ident: str = "material") -> str:
     return head + "\n".join(obj(d, "", None, root=True)) + "\n"
 
 
+def _rgl_file(model: BRDF) -> str | None:
+    """The absolute path of the RGL file an RGL model was read from, if it is still there."""
+    from ..measured.rgl import RGLBRDF
+
+    src = getattr(model, "source", "") if isinstance(model, RGLBRDF) else ""
+    return os.path.abspath(src) if src and os.path.isfile(src) else None
+
+
 def mitsuba_dict(model: BRDF, metric: str = "ngan", data=None) -> tuple[dict[str, Any], dict[str, Any]]:
     """The ``mi.load_dict`` dict for a model, and what went into it (exact, error, method, note)."""
     p = model.params
     info: dict[str, Any] = {"exact": False, "error": None, "relative_error": None, "method": "direct", "note": ""}
+    rgl_file = _rgl_file(model)
+    if rgl_file is not None:
+        info.update(exact=True, note="RGL .bsdf file -> Mitsuba's measured plugin, which reads the file itself "
+                                     "(referenced by its absolute path: keep it there)")
+        return {"type": "measured", "filename": rgl_file}, info
     if _is(model, "lambert"):
         info.update(exact=True, note="lambert -> diffuse")
         return {"type": "diffuse", "reflectance": {"type": "rgb", "value": _rgb(p["kd"])}}, info

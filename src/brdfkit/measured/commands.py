@@ -23,14 +23,37 @@ from ..cli_common import print_json
 
 
 def measured_names(set_name: str | None = None) -> list[str]:
-    """The built-in measured materials (``set/name``), optionally of one set (merl, rgl, nielsen)."""
+    """The built-in measured materials (``set/name``), optionally of one set (merl, rgl, nielsen);
+    or, when ``set_name`` is a folder, its measured files (:func:`measured_files`)."""
     from .nbrdf import SETS, materials
 
     if set_name in (None, "", "all"):
         return list(materials())
     if set_name not in SETS:
-        raise ValueError(f"unknown measured set {set_name!r}; valid sets: {', '.join(SETS)}, all")
+        if os.path.isdir(set_name):
+            return measured_files(set_name)
+        raise ValueError(f"unknown measured set {set_name!r}; valid sets: {', '.join(SETS)}, all, "
+                         "or a folder of measured files")
     return [n for n in materials() if n.split("/", 1)[0] == set_name]
+
+
+def measured_files(folder: str) -> list[str]:
+    """The measured-data files directly in ``folder`` (every suffix :mod:`brdfkit.sources` reads as
+    measured data: MERL ``.binary``, MERL/UTIA ``.bin``, RGL ``.bsdf``), sorted by name; hidden files
+    (an atomic write in flight) are skipped. A folder with none is a one-line ``ValueError``."""
+    from ..sources import FILE_KINDS, MEASURED
+
+    suffixes = sorted(s for s, k in FILE_KINDS.items() if k in MEASURED)
+    try:
+        names = sorted(os.listdir(folder))
+    except OSError as e:
+        raise ValueError(f"{folder}: cannot list the folder: {e.strerror or e}") from None
+    found = [os.path.join(folder, n) for n in names
+             if not n.startswith(".") and os.path.splitext(n)[1].lower() in suffixes
+             and os.path.isfile(os.path.join(folder, n))]
+    if not found:
+        raise ValueError(f"{folder}: no measured files in this folder (looked for {', '.join(suffixes)})")
+    return found
 
 
 def _fixed_for(model_name: str, items: List[str], strict: bool) -> dict[str, Any]:
@@ -93,7 +116,8 @@ def register(app: typer.Typer) -> None:
     @app.command("fit")
     def fit_cmd(
         source: Optional[str] = typer.Argument(
-            None, help="a MERL .binary file or a built-in material (e.g. merl/gold-metallic-paint)"
+            None, help="a measured file (MERL .binary, UTIA .bin, RGL .bsdf), a built-in material "
+                       "(e.g. merl/gold-metallic-paint) or any model"
         ),
         model: List[str] = typer.Option([], "--model", "-m",
                                         help="analytic model to fit; with --all-measured repeatable, "
@@ -107,7 +131,8 @@ def register(app: typer.Typer) -> None:
         as_json: bool = typer.Option(False, "--json", help="print the result as JSON"),
         report: Optional[str] = typer.Option(None, "--report", help="write a report (slices, spheres) into DIR"),
         all_measured: bool = typer.Option(False, "--all-measured", help="fit every built-in material"),
-        set_name: str = typer.Option("all", "--set", help="with --all-measured: merl, rgl, nielsen or all"),
+        set_name: str = typer.Option("all", "--set", help="with --all-measured: merl, rgl, nielsen, all, "
+                                            "or a folder of measured files (.binary, .bin, .bsdf)"),
         limit: int = typer.Option(0, "--limit", help="with --all-measured: only the first N materials"),
         out: str = typer.Option("fit-results", "--out", "-o", help="with --all-measured: output folder"),
         scheduler: Optional[str] = typer.Option(None, "--scheduler",
@@ -115,7 +140,7 @@ def register(app: typer.Typer) -> None:
         workers: int = typer.Option(0, "--workers", help="with --all-measured, no --scheduler: local processes (0: one per CPU)"),
         resume: bool = typer.Option(False, "--resume", help="with --all-measured: keep the fits already in --out"),
     ) -> None:
-        """Fit an analytic model to a measured material (MERL file or built-in); or a whole batch."""
+        """Fit an analytic model to a measured material (a file or a built-in one); or a whole batch."""
         from .. import registry
         from .metrics import METRICS
 
@@ -136,7 +161,11 @@ def register(app: typer.Typer) -> None:
             if given:
                 raise ValueError(f"{flag} needs --all-measured")
         if source is None:
-            raise ValueError("missing SOURCE: a MERL .binary file or a built-in material (see brdfkit list --measured)")
+            raise ValueError("missing SOURCE: a measured file (.binary, .bin, .bsdf) or a built-in material "
+                             "(see brdfkit list --measured)")
+        if os.path.isdir(source):
+            raise ValueError(f"{source} is a folder: fit every measured file in it with "
+                             f"--all-measured --set {source} --out DIR")
         if len(model) != 1:
             raise ValueError("fit one --model at a time for a single SOURCE (several models need --all-measured)")
         _, name, items = parse_model_spec(model[0])
@@ -148,7 +177,7 @@ def _tabulate_cmd(source, param, fmt, out, as_json, resolution, n_theta, n_phi, 
     from .tabulation import tabulate
 
     if out is None:
-        raise ValueError("missing -o PATH: the file to write (.bsdf for rgl, .binary for merl)")
+        raise ValueError("missing -o PATH: the file to write (.bsdf for rgl, .binary for merl, .bin for utia)")
     kw = dict(resolution=resolution, n_theta=n_theta, n_phi=n_phi, ndf_resolution=ndf_resolution,
               description=description)
     # the request (format, options, output path) is checked before the source is read
@@ -164,8 +193,8 @@ def _tabulate_cmd(source, param, fmt, out, as_json, resolution, n_theta, n_phi, 
         print_json(res.to_json())
         return
     sh = res.shape
-    size = (f"{sh['n_phi']} x {sh['n_theta']} incident directions, {sh['resolution']}^2 samples each"
-            if res.format == "rgl" else "90 x 90 x 180 bins")
+    size = {"rgl": lambda: f"{sh['n_phi']} x {sh['n_theta']} incident directions, {sh['resolution']}^2 samples each",
+            "utia": lambda: "6 x 48 x 6 x 48 angles", "merl": lambda: "90 x 90 x 180 bins"}[res.format]()
     typer.echo(f"wrote {res.path} ({res.format}, {res.bytes / 1e6:.2f} MB, {size}) in {res.seconds:.1f} s")
     if res.error is not None:
         typer.echo(f"  tabulation error {100 * res.error:.3g} % ({res.error_measure}, {res.error_pairs} pairs)")
@@ -206,8 +235,8 @@ def _register_tabulate(app: typer.Typer) -> None:
         source: str = typer.Argument(..., help="any model: a name (brdfkit list), a built-in material, "
                                                "a .brdf, a fit's .json, a MERL .binary or an RGL .bsdf file"),
         param: List[str] = typer.Option([], "--param", "-p", help="a parameter of the model: name=value (repeatable)"),
-        fmt: Optional[str] = typer.Option(None, "--format", "-f", help="merl or rgl (default: told by the suffix of -o)"),
-        out: Optional[str] = typer.Option(None, "--out", "-o", help="the file to write: .binary (merl) or .bsdf (rgl)"),
+        fmt: Optional[str] = typer.Option(None, "--format", "-f", help="merl, rgl or utia (default: told by the suffix of -o)"),
+        out: Optional[str] = typer.Option(None, "--out", "-o", help="the file to write: .binary (merl), .bsdf (rgl) or .bin (utia)"),
         as_json: bool = typer.Option(False, "--json", help="print a JSON summary (path, format, sizes, error)"),
         resolution: Optional[int] = typer.Option(None, "--resolution", help="rgl: samples per side of each table (64)"),
         n_theta: Optional[int] = typer.Option(None, "--n-theta", help="rgl: incident elevations (32)"),
@@ -216,7 +245,7 @@ def _register_tabulate(app: typer.Typer) -> None:
         ndf_resolution: Optional[int] = typer.Option(None, "--ndf-resolution", help="rgl: NDF nodes per side (64)"),
         description: Optional[str] = typer.Option(None, "--description", help="rgl: the file's description text"),
     ) -> None:
-        """Write any model as a measured file: MERL .binary or RGL .bsdf (Mitsuba 3's `measured`)."""
+        """Write any model as a measured file: MERL .binary, RGL .bsdf (Mitsuba 3's `measured`) or UTIA .bin."""
         _tabulate_cmd(source, param, fmt, out, as_json, resolution, n_theta, n_phi, ndf_resolution, description)
 
 
@@ -234,6 +263,11 @@ def _batch(models, param, metric, starts, samples, seed, set_name, limit, out, a
         raise ValueError(f"--workers must be >= 0, got {workers}")
     if limit:
         sources = sources[:limit]
+    if os.path.isdir(set_name):  # read every file once before any fit: a bad one is one line, not a dead batch
+        from ..sources import MEASURED, resolve
+
+        for path in sources:
+            resolve(path, kinds=MEASURED)
     specs = [parse_model_spec(m) for m in models]
     labels = [lab for lab, _, _ in specs]
     if len(set(labels)) != len(labels):

@@ -1,4 +1,4 @@
-"""``bk.tabulate`` / ``brdfkit tabulate``: any model written as a measured-data file.
+"""``bk.tabulate`` / ``brdfkit tabulate``: any model written as a measured-data file (MERL, RGL, UTIA).
 
 Formats (``format``, or told by the suffix of ``path``):
 
@@ -10,6 +10,8 @@ merl     ``.binary``  the model at the 90 x 90 x 180 bin centres of MERL's half/
 rgl      ``.bsdf``    Dupuy & Jakob's adaptive parameterization built from the model
                      (:mod:`brdfkit.measured.rgl_writer`): isotropic or anisotropic, RGB; Mitsuba 3's
                      ``measured`` plugin and :mod:`brdfkit.measured.rgl` read it
+utia     ``.bin``     the model at the UTIA grid (Filip & Vávra 2014: θ 0-75° by 15°, φ by 7.5°, for
+                     both directions; :func:`brdfkit.measured.utia.tabulate_utia`); isotropic or not
 =======  ==========  =============================================================================
 
 RGL options (defaults in brackets): ``resolution`` [64] samples per side of each incident
@@ -36,8 +38,9 @@ from typing import Any, Callable, Mapping
 
 import numpy as np
 
-FORMATS = {"merl": ".binary", "rgl": ".bsdf"}
-_ARTICLE = {"merl": "a MERL", "rgl": "an RGL"}
+FORMATS = {"merl": ".binary", "rgl": ".bsdf", "utia": ".bin"}
+_ARTICLE = {"merl": "a MERL", "rgl": "an RGL", "utia": "a UTIA"}
+_LISTED = ", ".join(f"{k} ({v})" for k, v in FORMATS.items())
 #: accepted ranges of the RGL options
 LIMITS = {"resolution": (4, 512), "n_theta": (2, 256), "n_phi": (3, 720), "ndf_resolution": (8, 128)}
 ERROR_PAIRS = 20000
@@ -93,9 +96,9 @@ def _format_of(path: str, fmt: str | None) -> str:
         for name, suf in FORMATS.items():
             if suffix == suf:
                 return name
-        raise ValueError(f"cannot tell the format from {path!r}: give format 'merl' (.binary) or 'rgl' (.bsdf)")
+        raise ValueError(f"cannot tell the format from {path!r}: give a format, {_LISTED}")
     if not isinstance(fmt, str) or fmt.lower() not in FORMATS:
-        raise ValueError(f"unknown format {fmt!r}; valid formats: merl (.binary), rgl (.bsdf)")
+        raise ValueError(f"unknown format {fmt!r}; valid formats: {_LISTED}")
     fmt = fmt.lower()
     if suffix != FORMATS[fmt]:
         raise ValueError(f"{_ARTICLE[fmt]} file must end in {FORMATS[fmt]} (so that it is read back as {fmt}), "
@@ -113,13 +116,14 @@ def _check_int(name: str, value) -> int:
 
 
 def _rgl_options(fmt: str, opts: Mapping[str, Any]) -> dict[str, Any]:
-    """The RGL options, checked (one line each); for MERL, none may be given."""
+    """The RGL options, checked (one line each); for MERL and UTIA, none may be given."""
     from .rgl_writer import DEFAULTS
 
     given = {k: v for k, v in opts.items() if v is not None}
-    if fmt == "merl":
+    if fmt != "rgl":
         if given:
-            raise ValueError(f"{next(iter(given))} applies to format 'rgl' only (a MERL file has fixed bins)")
+            raise ValueError(f"{next(iter(given))} applies to format 'rgl' only "
+                             f"({_ARTICLE[fmt]} file has fixed bins)")
         return {}
     out = dict(DEFAULTS, isotropic=None, description=None)
     for k, v in given.items():
@@ -181,7 +185,7 @@ def tabulate(source, path, format: str | None = None, *, params: Mapping[str, An
              error_pairs: int = ERROR_PAIRS, progress: bool | Callable[[int, int], None] = False,
              model=None) -> TabulateResult:
     """Write ``source`` (any model :mod:`brdfkit.sources` resolves, with ``params``) to ``path``
-    as a MERL ``.binary`` or RGL ``.bsdf`` file; see the module docstring. Returns a
+    as a MERL ``.binary``, RGL ``.bsdf`` or UTIA ``.bin`` file; see the module docstring. Returns a
     :class:`TabulateResult`. Bad input: a one-line ``ValueError`` before any work.
 
     ``model``: the already-built model of ``source`` (the CLI resolves it with ``-p`` strings)."""
@@ -207,6 +211,11 @@ def tabulate(source, path, format: str | None = None, *, params: Mapping[str, An
 
         write_merl_table(merl_table(model), path)
         shape = {"theta_h": 90, "theta_d": 90, "phi_d": 180}
+    elif fmt == "utia":
+        from .utia import N_PHI, N_THETA, tabulate_utia, write_utia_table
+
+        write_utia_table(tabulate_utia(model), path)
+        shape = {"theta_i": N_THETA, "phi_i": N_PHI, "theta_v": N_THETA, "phi_v": N_PHI}
     else:
         from .rgl_writer import rgl_tables
         from .tensor_file import write_tensor_file

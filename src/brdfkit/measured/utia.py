@@ -27,7 +27,9 @@ degrees, φ periodic (the corner after 352.5° is 0°).  Above the last θ sampl
 (75° < θ ≤ 90°) the reference keeps the last two θ samples (60°, 75°) and so
 extrapolates linearly; brdfkit does the same and clamps the result at 0
 (linear extrapolation can go negative).  Below the horizon (θ > 90°, i.e.
-cos θ ≤ 0) the value is 0, as in the reference.
+cos θ ≤ 0) the value is 0, as in the reference. Values above float32's largest (3.4e38 1/sr:
+no measurement) are refused at load, and a lookup is clamped to it, so that extrapolation
+never gives inf (as the RGL reader clamps).
 """
 
 from __future__ import annotations
@@ -47,6 +49,8 @@ STEP_THETA_DEG = 15.0
 STEP_PHI_DEG = 7.5
 SHAPE = (N_CHANNELS, N_THETA, N_PHI, N_THETA, N_PHI)
 FILE_BYTES = int(np.prod(SHAPE)) * 8
+#: the largest value a table may hold and a lookup may return (float32's largest, as the RGL reader)
+MAX_VALUE = float(np.finfo(np.float32).max)
 
 
 def grid_angles() -> tuple[np.ndarray, np.ndarray]:
@@ -82,7 +86,7 @@ def _phi_corners(phi_deg: np.ndarray):
 def utia_lookup(table: np.ndarray, theta_i, phi_i, theta_v, phi_v) -> np.ndarray:
     """Quadrilinear lookup in a ``(3, 6, 48, 6, 48)`` table; angles in radians, returns ``(..., 3)``.
 
-    Zero where either θ > 90°; linear extrapolation above 75° clamped at 0.
+    Zero where either θ > 90°; linear extrapolation above 75° clamped to [0, MAX_VALUE].
     """
     ti, pi_, tv, pv = np.broadcast_arrays(*(np.asarray(x, dtype=np.float64) for x in (theta_i, phi_i, theta_v, phi_v)))
     shape = ti.shape
@@ -98,7 +102,7 @@ def utia_lookup(table: np.ndarray, theta_i, phi_i, theta_v, phi_v) -> np.ndarray
                 for d, fd in ((d0, 1.0 - wd), (d1, wd)):
                     w = fa * fb * fc * fd
                     out += table[:, a, b, c, d].T * w[:, None]
-    out = np.maximum(out, 0.0)
+    out = np.clip(out, 0.0, MAX_VALUE)
     below = (ti > 90.0) | (tv > 90.0)
     out[below] = 0.0
     return out.reshape(shape + (N_CHANNELS,))
@@ -137,8 +141,8 @@ class UTIABRDF(BRDF):
         table = np.asarray(table, dtype=np.float64)
         if table.shape != SHAPE:
             raise ValueError(f"utia: table must have shape {SHAPE}, got {table.shape}")
-        if not np.isfinite(table).all() or (table < 0).any():
-            raise ValueError("utia: table has NaN, infinite or negative values")
+        if not np.isfinite(table).all() or (table < 0).any() or (table > MAX_VALUE).any():
+            raise ValueError(f"utia: table has NaN, infinite, negative or absurd (> {MAX_VALUE:.3g}) values")
         self.table = np.ascontiguousarray(table)
         self.table.setflags(write=False)
         self.label = label
@@ -169,7 +173,10 @@ def read_utia_table(path: str | os.PathLike) -> np.ndarray:
     path = os.fspath(path)
     if os.path.isdir(path):
         raise ValueError(f"{path}: is a directory, not a UTIA .bin file")
-    size = os.path.getsize(path)  # OSError if missing
+    try:
+        size = os.path.getsize(path)
+    except OSError as e:
+        raise ValueError(f"{path}: {'no such file' if not os.path.exists(path) else e.strerror or e}") from None
     if size != FILE_BYTES:
         what = "empty" if size == 0 else ("truncated" if size < FILE_BYTES else "has trailing data")
         raise ValueError(f"{path}: {what}: {size} bytes, a UTIA .bin file has exactly {FILE_BYTES} bytes")
@@ -179,6 +186,8 @@ def read_utia_table(path: str | os.PathLike) -> np.ndarray:
         raise ValueError(f"{path}: UTIA data has NaN or infinite values")
     if (data < 0).any():
         raise ValueError(f"{path}: UTIA data has negative values")
+    if (data > MAX_VALUE).any():
+        raise ValueError(f"{path}: UTIA data has absurd values (above {MAX_VALUE:.3g} 1/sr)")
     return data.reshape(SHAPE).astype(np.float64)
 
 

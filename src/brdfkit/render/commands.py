@@ -46,7 +46,7 @@ def register(app: typer.Typer) -> None:
             None, "--opengl", help="an OpenGL fixed-function material from the lecture's table (e.g. gold)"
         ),
         measured: Optional[str] = typer.Option(
-            None, "--measured", help="a built-in measured material (e.g. merl/gold-metallic-paint) or a MERL file"
+            None, "--measured", help="a built-in measured material (e.g. merl/gold-metallic-paint) or a measured file (.binary, .bin, .bsdf)"
         ),
         mesh: Optional[str] = typer.Option(None, "--mesh", help="sphere, torus, teapot, or an OBJ/PLY path"),
         shading: Optional[str] = typer.Option(None, "--shading", help="flat | gouraud | phong"),

@@ -13,7 +13,8 @@ A scene file (SPEC.md, ``brdfkit render --scene scene.json -o out.png``)::
       "light_model": {"ambient": [0.2, 0.2, 0.2], "local_viewer": false},
       "material": {"opengl": "gold"},            # or {"opengl": {ambient, diffuse, specular,
                                                 # emission, shininess}} or {"model": NAME, "params": {...}}
-                                                # or {"measured": "merl/gold-metallic-paint"} or {"merl": PATH}
+                                                # or {"measured": "merl/gold-metallic-paint" or PATH}
+                                                # or {"merl": PATH} (a MERL .binary, UTIA .bin or RGL .bsdf)
       "shading": "phong",                        # flat | gouraud | phong
       "background": [0, 0, 0, 1],
       "antialias": true,
@@ -26,7 +27,8 @@ Every field is optional: the defaults are the teapot, the default camera
 (:data:`brdfkit.render.camera.DEFAULT_CAMERA`), 512×512, one white
 directional light from the upper left (:data:`DEFAULT_LIGHTS`), OpenGL's
 light model, gold, Phong shading, an opaque black background, antialiasing.
-Relative mesh and MERL paths are resolved against the scene file's folder.
+Relative mesh and measured-file paths are resolved against the scene file's folder
+(``measured``: when the file is there).
 
 A scene file is untrusted input: every field is checked before anything is
 built, and a bad one is a one-line ``ValueError`` that names it (``scene
@@ -150,7 +152,7 @@ def material_from_spec(spec: Any) -> Any:
             return resolve(spec["measured"], kinds=MEASURED)
         if not isinstance(spec["merl"], (str, os.PathLike)) or not str(spec["merl"]):
             raise ValueError(f"material 'merl' must be a file name (a string), got {spec['merl']!r}")
-        return resolve(spec["merl"], kinds=("merl",))
+        return resolve(spec["merl"], kinds=("merl", "bin", "rgl"))  # any measured file: MERL, UTIA, RGL
     if "model" in spec:
         extra = set(spec) - {"model", "params"}
         if extra:
@@ -278,6 +280,18 @@ def _check_fields(obj: Mapping[str, Any]) -> None:
         raise ValueError(f"scene field 'material': 'merl' must be a file name (a string), got {_short(mat['merl'])}")
 
 
+def _beside_scene(spec: Mapping[str, Any], base_dir) -> Mapping[str, Any]:
+    """``{"measured": PATH}`` with a relative file path: the file beside the scene file, when it is there."""
+    from ..sources import FILE_KINDS
+
+    v = spec["measured"]
+    if isinstance(v, str) and not os.path.isabs(v) and os.path.splitext(v)[1].lower() in FILE_KINDS:
+        there = os.path.join(os.fspath(base_dir), v)
+        if os.path.isfile(there):
+            return {**spec, "measured": there}
+    return spec
+
+
 def scene_from_json(obj: Mapping[str, Any], base_dir: str | os.PathLike | None = None) -> tuple[Scene, Look]:
     """A :class:`Scene` and its :class:`Look` from a scene file's object."""
     if not isinstance(obj, Mapping):
@@ -299,6 +313,8 @@ def scene_from_json(obj: Mapping[str, Any], base_dir: str | os.PathLike | None =
     if isinstance(mat_spec, Mapping) and "merl" in mat_spec and base_dir is not None:
         if not os.path.isabs(mat_spec["merl"]):
             mat_spec = {"merl": os.path.join(os.fspath(base_dir), mat_spec["merl"])}
+    if isinstance(mat_spec, Mapping) and "measured" in mat_spec and base_dir is not None:
+        mat_spec = _beside_scene(mat_spec, base_dir)
     scene = make_scene(
         mesh=_field("mesh", mesh_from_spec, mesh_spec),
         material=_field("material", material_from_spec, mat_spec),
