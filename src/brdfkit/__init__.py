@@ -111,11 +111,11 @@ def export(model, fmt: str, path, **kw):
 __all__ += ["load_brdf", "export"]
 
 
-# -- explicit microsurfaces (brdfkit.microsurface; Mitsuba 3 traces them; imported on first use) ---
+# -- explicit microsurfaces (brdfkit.microsurfaces; Mitsuba 3 traces them; imported on first use) ---
 def microsurface(kind: str, **params):
     """An explicit microsurface (``"v-groove"``, ``"beckmann"``, ``"ggx"``) with simulated masking,
-    albedo and BRDF (see :mod:`brdfkit.microsurface`)."""
-    from .microsurface import microsurface as _f
+    albedo and BRDF (see :mod:`brdfkit.microsurfaces`)."""
+    from .microsurfaces import microsurface as _f
 
     return _f(kind, **params)
 

@@ -1,6 +1,6 @@
 """Tracing light through a periodic microsurface tile: masking, shadowing, every inter-reflection.
 
-Rays live in the tile's base frame (:mod:`brdfkit.microsurface.surfaces`). A ray that leaves the
+Rays live in the tile's base frame (:mod:`brdfkit.microsurfaces.surfaces`). A ray that leaves the
 tile through a side re-enters through the opposite side (the surface is periodic, so this is the
 same as an infinite surface); one that rises through the plane ``z = zmax`` can meet nothing more
 and has left the surface. At a hit, the ray reflects specularly about the triangle's normal (in

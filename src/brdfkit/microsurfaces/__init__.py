@@ -15,10 +15,13 @@ Estimators (all with their standard errors)
   and a ray is traced from each toward ``wo``; ``G1 = Σ area·escaped / Σ area`` (a ratio
   estimator; its standard error by the delta method).
 * ``albedo(wi)`` — rays arrive from ``wi`` uniformly over the macro surface and are traced until
-  they leave; the directional albedo is the mean weight (Fresnel products) that leaves, split by
-  the number of reflections.
+  they leave (uniform over the macro surface, the rays carry equal shares of the irradiance); the
+  directional albedo is the mean weight (Fresnel products) that leaves, split by the number of
+  reflections.
 * ``measure(wi, wo)`` — the same rays, binned: the BRDF averaged over a cone of half-angle
-  ``radius`` around ``wo`` is ``(Σ weight in the cone / N) / (cos θi ∫_cone cos θ dω)``. The cone
+  ``radius`` around ``wo`` is ``(Σ weight in the cone / N) / ∫_cone cos θ dω`` (the reflected
+  flux fraction is ``f cos θo dω``; the rays' uniform spread over the macro area already is the
+  irradiance, so no cos θi). The cone
   is a bias of second order in ``radius`` (smaller cones, more noise).
 
 =============  ======  ==============  ==============================================================
@@ -249,7 +252,7 @@ class Microsurface:
                 if o[2] <= 0:
                     continue
                 in_cone = (paths.wo @ o) >= cos_r
-                norm = w[2] * cone_cosine_integral(o, radius)
+                norm = cone_cosine_integral(o, radius)
                 x = wts * in_cone[:, None] / norm
                 val[r], err[r] = x.mean(0), x.std(0, ddof=1) / np.sqrt(samples)
         return Estimate(val.reshape(shape + (3,)), err.reshape(shape + (3,)))
