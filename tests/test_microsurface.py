@@ -13,6 +13,7 @@ pytest.importorskip("mitsuba")
 
 from brdfkit.microsurfaces import Microsurface, available, cone_cosine_integral, microsurface  # noqa: E402
 from brdfkit.microsurfaces.surfaces import gaussian_field, ggx_mixture_weights  # noqa: E402
+from brdfkit.microsurfaces.theory import ggx_mixture_single_scattering  # noqa: E402
 from brdfkit.terms.shadowing import smith_g1, v_groove  # noqa: E402
 
 pytestmark = pytest.mark.skipif(not available("mitsuba-llvm"), reason="Mitsuba 3's llvm_ad_rgb variant is not available")
@@ -106,9 +107,10 @@ def test_conductor_single_bounce_albedo_is_fresnel_weighted():
     assert np.allclose(alb.by_bounce[0], want, atol=1e-9) and np.allclose(alb.total, want, atol=1e-9)
 
 
-def _binned_single_bounce(s, wi, n, nt=9, nphi=12, sub=6):
+def _binned_single_bounce(s, wi, n, nt=9, nphi=12, sub=6, reference=None):
     """Simulated single-bounce BRDF averaged over bins of equal projected solid angle, the analytic
-    one averaged over the same bins, and the simulation's standard errors."""
+    one (``reference(wi, wo)``, else the surface's ``microfacet`` smith-correlated model) averaged
+    over the same bins, and the simulation's standard errors."""
     paths = s.shoot(wi, n)
     keep = (paths.status == 0) & (paths.bounces == 1)
     wo, wgt = paths.wo[keep], paths.weight[keep, 0]
@@ -122,7 +124,8 @@ def _binned_single_bounce(s, wi, n, nt=9, nphi=12, sub=6):
     v = (np.arange(nphi * sub) + 0.5) / (nphi * sub)
     uu, vv = np.meshgrid(u, v, indexing="ij")
     w = np.stack([np.sqrt(uu) * np.cos(2 * np.pi * vv), np.sqrt(uu) * np.sin(2 * np.pi * vv), np.sqrt(1 - uu)], -1)
-    f = s.model("smith-correlated").eval(np.broadcast_to(wi, w.shape), w)[..., 0]
+    wib = np.broadcast_to(wi, w.shape)
+    f = reference(wib, w) if reference else s.model("smith-correlated").eval(wib, w)[..., 0]
     return hist / proj, f.reshape(nt, sub, nphi, sub).mean((1, 3)), np.sqrt(hist * (1 - hist) / n) / proj
 
 
@@ -135,6 +138,19 @@ def test_single_bounce_beckmann_brdf_matches_microfacet():
         rel = np.sqrt(np.sum((sim - ref) ** 2) / np.sum(ref**2))
         noise = np.sqrt(np.sum(se**2) / np.sum(ref**2))
         assert noise < 0.016 and rel < 0.03, (np.degrees(t), rel, noise)
+
+
+def test_single_bounce_ggx_mixture_matches_its_theory():
+    """The GGX surface (a Beckmann scale mixture) reflects once as the average of its tiles'
+    microfacet BRDFs (:mod:`brdfkit.microsurfaces.theory`): relative RMS < 5 % at α = 0.5 (noise
+    part ~3 %). Its distance from the microfacet GGX model (14 % at θi = 70°) is the construction's."""
+    s = microsurface("ggx", alpha=0.5)
+    ref = lambda wi, wo: ggx_mixture_single_scattering(wi, wo, 0.5, n=200)  # noqa: E731
+    for t in np.radians([0.0, 70.0]):
+        sim, f, se = _binned_single_bounce(s, _dirs(t), 150_000, reference=ref)
+        rel = np.sqrt(np.sum((sim - f) ** 2) / np.sum(f**2))
+        noise = np.sqrt(np.sum(se**2) / np.sum(f**2))
+        assert noise < 0.035 and rel < 0.05, (np.degrees(t), rel, noise)
 
 
 def test_reciprocity_within_standard_error():

@@ -58,9 +58,10 @@ def propagate(engine: MitsubaEngine, tile: Tile, o: np.ndarray, d: np.ndarray):
         tb, side = _box_exit(tile, zmax, po, dd)
         t, f = engine.intersect(po, dd, tb)
         hit = f >= 0
-        pn = po + np.where(hit, t, tb)[:, None] * dd
-        top = ~hit & (side == 2)
-        wrap = ~hit & ~top
+        stuck = ~hit & ~np.isfinite(tb)  # straight down and through a crack: nothing ahead, lost
+        pn = po + np.where(hit, t, np.where(stuck, 0.0, tb))[:, None] * dd
+        top = ~hit & ~stuck & (side == 2)
+        wrap = ~hit & ~stuck & ~top
         # re-enter through the opposite side exactly (no drift through the modulo)
         wx = wrap & (side == 0)
         wy = wrap & (side == 1)
