@@ -35,7 +35,7 @@ fresnel        choice  white           ``white`` (F = 1) or a ``microfacet`` Fre
                                        dielectric | schlick, with ``eta``, ``k``, ``f0`` as there
 resolution     int     512             grid cells per side of the random tile
 seed           int     0               the random tile and the rays
-engine         choice  mitsuba-llvm    ``mitsuba-llvm`` | ``mitsuba-scalar`` (:mod:`.engines`)
+engine         choice  mitsuba-llvm    ``mitsuba-llvm`` | ``mitsuba-scalar`` | ``embree`` (:mod:`.engines`)
 max_bounces    int     64              reflections after which a ray counts as lost
 =============  ======  ==============  ==============================================================
 """
@@ -48,7 +48,7 @@ import numpy as np
 
 from ..models.microfacet import Microfacet, fresnel_term
 from . import surfaces as _surf
-from .engines import ENGINES, MitsubaEngine, available
+from .engines import ENGINES, MitsubaEngine, available, make_engine
 from .surfaces import Tile
 from .tracer import EPS_REL, Paths, propagate, trace
 
@@ -140,7 +140,7 @@ class Microsurface:
         tile = self.tile
         key = (id(tile), self.engine_name)
         if key not in _ENGINES:
-            _ENGINES[key] = MitsubaEngine(tile, self.engine_name)
+            _ENGINES[key] = make_engine(tile, self.engine_name)
         return _ENGINES[key]
 
     def scales(self, n: int) -> _surf.Scales:
