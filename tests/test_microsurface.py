@@ -217,3 +217,28 @@ def test_engines_hit_the_same_triangles(other):
     assert np.mean(f0 == f1) > 0.99 and np.mean(f0 >= 0) > 0.5
     same = (f0 == f1) & (f0 >= 0)
     assert np.allclose(t0[same], t1[same], rtol=1e-4, atol=1e-5)
+
+
+def test_measure_cli_writes_a_merl_file(cli, tmp_path):
+    """``brdfkit measure`` traces, bins and writes a MERL file that brdfkit reads back."""
+    import brdfkit as bk
+
+    out = tmp_path / "b.binary"
+    rc, stdout, err = cli("measure", "beckmann", "-p", "alpha=0.5", "-p", "fresnel=white", "-o", str(out),
+                          "--samples", "3000", "--n-theta", "3", "--json")
+    assert rc == 0, err
+    m = bk.load_measured(out)
+    f = m.eval(_dirs(np.radians(20.0)), _dirs(np.radians(20.0), np.pi))
+    assert np.all(np.isfinite(f)) and np.all(f > 0)
+
+
+@pytest.mark.parametrize("args, msg", [
+    (["measure", "sphere", "-o", "x.binary"], "unknown microsurface kind"),
+    (["measure", "ggx", "-p", "alpha=abc", "-o", "x.binary"], "alpha"),
+    (["measure", "v-groove", "-o", "x.binary"], "isotropic"),
+    (["measure", "ggx"], "missing -o"),
+])
+def test_measure_cli_bad_input(cli, tmp_path, monkeypatch, args, msg):
+    monkeypatch.chdir(tmp_path)
+    rc, _, err = cli(*args)
+    assert rc != 0 and msg in err and "Traceback" not in err

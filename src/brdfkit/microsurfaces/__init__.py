@@ -219,6 +219,15 @@ class Microsurface:
         se = lambda a: np.std(a, axis=-2, ddof=1) / np.sqrt(n)  # noqa: E731
         return Albedo(contrib.mean(0), se(contrib), split.mean(1), se(split), float(np.mean(paths.status != 0)))
 
+    def table(self, n_theta: int = 24, n_u: int = 48, n_phi: int = 48, samples: int = 200000,
+              bounces: int | None = None, progress=None):
+        """The whole simulated BRDF as a model (:class:`~brdfkit.microsurfaces.table.SimulatedTable`):
+        ``samples`` paths from each of ``n_theta`` incident angles, binned (see :mod:`.table`).
+        ``progress``: a callable ``step(done)`` called after each incident angle."""
+        from .table import simulate
+
+        return simulate(self, n_theta, n_u, n_phi, samples, bounces, progress)
+
     def measure(self, wi, wo, samples: int = 200000, bounces: int | None = None, radius: float = 0.05) -> Estimate:
         """Simulated BRDF (1/sr, no cosine) at ``(wi, wo)`` pairs, shape ``(..., 3)`` like ``m.eval``.
 
