@@ -164,8 +164,9 @@ class Microsurface:
         samples = _int_param("samples", samples, 2)
         flat = wo.reshape(-1, 3)
         val, err = np.empty(len(flat)), np.empty(len(flat))
-        for r, w in enumerate(flat):
-            val[r], err[r] = self._masking_one(w, samples)
+        with self.engine.session():
+            for r, w in enumerate(flat):
+                val[r], err[r] = self._masking_one(w, samples)
         return Estimate(val.reshape(wo.shape[:-1]), err.reshape(wo.shape[:-1]))
 
     def _masking_one(self, wo: np.ndarray, n: int) -> tuple[float, float]:
@@ -197,8 +198,9 @@ class Microsurface:
         tile, rng = self.tile, self._rng
         lx, ly = tile.size
         o = np.stack([rng.uniform(0, lx, n), rng.uniform(0, ly, n), np.full(n, tile.zmax)], axis=-1)
-        return trace(self.engine, tile, self.scales(n), o, np.broadcast_to(-wi, (n, 3)), self.fresnel,
-                     self.max_bounces, record=record)
+        with self.engine.session():
+            return trace(self.engine, tile, self.scales(n), o, np.broadcast_to(-wi, (n, 3)), self.fresnel,
+                         self.max_bounces, record=record)
 
     def albedo(self, wi, bounces: int = 3, samples: int = 100000) -> Albedo | list[Albedo]:
         """Directional albedo from ``wi`` split into 1..``bounces`` reflections and the rest."""
