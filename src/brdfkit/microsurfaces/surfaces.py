@@ -72,7 +72,8 @@ class Tile:
         return float(self.heights.max())
 
     def slopes(self) -> np.ndarray:
-        """The triangles' slopes ``(x̃, ỹ) = (−n_x/n_z, −n_y/n_z)`` (slope space as in Heitz 2014), shape ``(F, 2)`` (equal projected areas)."""
+        """The triangles' slopes ``(x̃, ỹ) = (−n_x/n_z, −n_y/n_z)`` (slope space as in Heitz 2014),
+        shape ``(F, 2)``; every triangle has the same projected area, so this is the slope sample."""
         n = self.normals
         return np.stack([-n[:, 0] / n[:, 2], -n[:, 1] / n[:, 2]], axis=-1)
 
