@@ -111,6 +111,18 @@ def export(model, fmt: str, path, **kw):
 __all__ += ["load_brdf", "export"]
 
 
+# -- explicit microsurfaces (brdfkit.microsurfaces; Mitsuba 3 traces them; imported on first use) ---
+def microsurface(kind: str, **params):
+    """An explicit microsurface (``"v-groove"``, ``"beckmann"``, ``"ggx"``) with simulated masking,
+    albedo and BRDF (see :mod:`brdfkit.microsurfaces`)."""
+    from .microsurfaces import microsurface as _f
+
+    return _f(kind, **params)
+
+
+__all__ += ["microsurface"]
+
+
 # -- Jupyter display: attached to BRDF here, so that brdfkit.models never imports interchange;
 #    the work (and the import of brdfkit.interchange.notebook) happens on the first display ---
 def _attach_notebook_display(cls: type) -> None:

@@ -51,6 +51,7 @@ _PLUGINS: tuple[str, ...] = (
     "brdfkit.render.commands",
     "brdfkit.web.commands",
     "brdfkit.interchange.commands",
+    "brdfkit.microsurfaces.commands",
 )
 
 #: each command's plugin, so that a run imports only the plugin of the command it runs (``brdfkit
@@ -68,6 +69,7 @@ COMMANDS: dict[str, str] = {
     "gallery": "brdfkit.render.commands",
     "serve": "brdfkit.web.commands",
     "export": "brdfkit.interchange.commands",
+    "measure": "brdfkit.microsurfaces.commands",
 }
 _REGISTERED: set[str] = set()
 
