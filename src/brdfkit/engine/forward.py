@@ -108,6 +108,7 @@ class _Func:
             raise Unsupported(f"{self.py.__qualname__}: {len(arg_patterns)} argument patterns for {len(self.args)}")
         self.arg_patterns = dict(zip(self.args, arg_patterns))
         self.g = self.py.__globals__
+        self.assigned = {t.id for node in ast.walk(self.fdef) for t in _targets(node)}
         self.ntmp = 0
         self.callees: dict[str, tuple[Callable, tuple]] = {}  # generated name -> (twin, return patterns)
         self.callee_src: dict[str, tuple[Callable, tuple]] = {}
@@ -201,7 +202,26 @@ class _Func:
     def _arg_pat(self, a) -> object:
         if isinstance(a, ast.Name) and self.arg_patterns.get(a.id) == P_ARRAY and a.id in self.args:
             return P_ARRAY
+        k = self.static_int(a)
+        if k is not None:  # an integer known here (an offset into p): the callee is specialised to it
+            return ("int", k)
         return self.epat(a)
+
+    def static_int(self, e):
+        """The value of an integer expression known when the function is transformed, else None."""
+        if isinstance(e, ast.Constant) and type(e.value) is int:
+            return e.value
+        if isinstance(e, ast.Name):
+            p = self.arg_patterns.get(e.id)
+            if isinstance(p, tuple) and p[0] == "int" and e.id not in self.assigned:
+                return p[1]
+            return None
+        if isinstance(e, ast.BinOp) and isinstance(e.op, (ast.Add, ast.Sub, ast.Mult)):
+            a, b = self.static_int(e.left), self.static_int(e.right)
+            if a is None or b is None:
+                return None
+            return a + b if isinstance(e.op, ast.Add) else (a - b if isinstance(e.op, ast.Sub) else a * b)
+        return None
 
     def _call_pats(self, call: ast.Call) -> tuple:
         obj = self._callee(call)
@@ -228,11 +248,10 @@ class _Func:
             return self.epat(e.body) | self.epat(e.orelse)
         if isinstance(e, ast.Subscript):
             v = e.value
-            if (isinstance(v, ast.Name) and self.arg_patterns.get(v.id) == P_ARRAY
-                    and isinstance(e.slice, ast.Constant) and isinstance(e.slice.value, int)
-                    and 0 <= e.slice.value < self.n):
-                return frozenset([e.slice.value])
-            return EMPTY
+            k = self.static_int(e.slice)
+            if isinstance(v, ast.Name) and self.arg_patterns.get(v.id) == P_ARRAY and k is not None and 0 <= k < self.n:
+                return frozenset([k])
+            return EMPTY  # a table in p, or another array: a constant
         if isinstance(e, ast.Attribute):
             return EMPTY
         if isinstance(e, ast.Call):
@@ -245,7 +264,7 @@ class _Func:
             if fname in ("int", "len", "range", "bool"):
                 return EMPTY
             out = EMPTY
-            for a in e.args:
+            for a in (e.args[1:] if fname == "select" else e.args):
                 out |= self.epat(a)
             if fname in ("floor", "ceil", "trunc"):
                 return EMPTY
@@ -308,7 +327,10 @@ class _Func:
                     out.append(pad + "else:")
                     out.extend(self._stmts(st.orelse, ind + 1) or [pad + "    pass"])
             elif isinstance(st, ast.For):
-                pre, it = self._value(st.iter)
+                if isinstance(st.iter, ast.Tuple) and all(isinstance(x, ast.Constant) for x in st.iter.elts):
+                    pre, it = [], ast.unparse(st.iter)  # a loop over constants
+                else:
+                    pre, it = self._value(st.iter)
                 out.extend(pad + ln for ln in pre)
                 out.append(pad + f"for {st.target.id} in {it}:")
                 out.extend(self._stmts(st.body, ind + 1) or [pad + "    pass"])
@@ -549,6 +571,13 @@ class _Func:
         t = self.tmp()
         keys = sorted(set().union(*[set(d) for d in ders]))
         d_out = {}
+        if fname == "select" and len(vals) == 3:  # brdfkit.engine.select: both values computed, one chosen
+            c, a, b = vals
+            lines.append(f"{t} = {func}({c}, {a}, {b})")
+            for j in sorted(set(ders[1]) | set(ders[2])):
+                lines.append(f"{t}__d{j} = {func}({c}, {ders[1].get(j, '0.0')}, {ders[2].get(j, '0.0')})")
+                d_out[j] = f"{t}__d{j}"
+            return lines, t, d_out
         if fname in ("min", "max") and len(vals) >= 2:
             # fold pairwise; the derivative of the argument Python's rule returns
             cur_v, cur_d = vals[0], ders[0]
@@ -604,6 +633,20 @@ class _Func:
         raise Unsupported(f"no derivative rule for {func}()")
 
 
+def _targets(node):
+    """The names a statement assigns."""
+    if isinstance(node, ast.Assign):
+        tg = node.targets
+    elif isinstance(node, (ast.AugAssign, ast.For)):
+        tg = [node.target]
+    else:
+        return []
+    out = []
+    for t in tg:
+        out.extend(x for x in ast.walk(t) if isinstance(x, ast.Name))
+    return out
+
+
 def _subst(rule: str, x: str, r: str) -> str:
     """``rule`` with the whole-word names ``x`` and ``r`` replaced."""
     import re
@@ -654,6 +697,8 @@ def _callee_by_key(key: str) -> Callable:
 def _pat_str(p) -> str:
     if p == P_ARRAY:
         return "P"
+    if isinstance(p, tuple):
+        return f"i{p[1]}"
     if not p:
         return "c"
     return "d" + "-".join(str(j) for j in sorted(p))
@@ -664,7 +709,7 @@ def forward_function(fn: Callable, arg_patterns: tuple, n: int) -> tuple[Callabl
     ``arg_patterns`` (a frozenset per argument, :data:`P_ARRAY` for the parameter array). Where no
     argument carries a tangent, ``fn`` itself (its results carry none)."""
     py = getattr(fn, "py_func", fn)
-    if all(not (p == P_ARRAY or p) for p in arg_patterns):
+    if all(not (p == P_ARRAY or isinstance(p, frozenset) and p) for p in arg_patterns):
         # nothing flows in: the original, its results constants (arity from a trial analysis)
         key = (id(py), arg_patterns, n)
         with _LOCK:
@@ -680,7 +725,11 @@ def forward_function(fn: Callable, arg_patterns: tuple, n: int) -> tuple[Callabl
         if hit is not None:
             return hit
         tr = _Func(fn, arg_patterns, n)
-        fsrc = tr.generate()
+        try:
+            fsrc = tr.generate()
+        except Unsupported as e:
+            msg = str(e)
+            raise Unsupported(msg if msg.startswith("in ") else f"in {py.__qualname__}: {msg}") from None
         stem = (f"fwd_{py.__module__}_{py.__name__}__n{n}__" + "_".join(_pat_str(p) for p in arg_patterns))
         stem = stem.replace(".", "_")
         if len(stem) > 180:
