@@ -67,17 +67,21 @@ def _expr(src: str) -> ast.expr:
 
 
 _MATH_UNARY = {
-    # name: derivative as a source template in x (the argument) and r (the result)
+    # name: derivative as a source template in x (the argument) and r (the result). Where the derivative is
+    # infinite (acos at ±1, log at 0) the rule gives the IEEE infinity instead of dividing by zero, which
+    # raises in Python (the reference engine) and gives inf in numba: both engines then compute the same
+    # tangent (inf · 0 = nan where a zero tangent meets it, dropped when it only feeds floor/int/a comparison,
+    # as in htsg_series.thinning_step).
     "sqrt": "(0.5 / r if r > 0.0 else 0.0)",
     "exp": "r",
-    "log": "(1.0 / x)",
-    "log1p": "(1.0 / (1.0 + x))",
+    "log": "(1.0 / x if x != 0.0 else math.inf)",
+    "log1p": "(1.0 / (1.0 + x) if x != -1.0 else math.inf)",
     "expm1": "(r + 1.0)",
     "sin": "math.cos(x)",
     "cos": "(-math.sin(x))",
     "tan": "(1.0 + r * r)",
-    "asin": "(1.0 / math.sqrt(1.0 - x * x))",
-    "acos": "(-1.0 / math.sqrt(1.0 - x * x))",
+    "asin": "(1.0 / math.sqrt(1.0 - x * x) if x * x < 1.0 else math.inf)",
+    "acos": "(-1.0 / math.sqrt(1.0 - x * x) if x * x < 1.0 else -math.inf)",
     "atan": "(1.0 / (1.0 + x * x))",
     "sinh": "math.cosh(x)",
     "cosh": "math.sinh(x)",
@@ -542,7 +546,7 @@ class _Func:
             elif sym == "**":
                 terms = []
                 if x:
-                    terms.append(f"{b} * {a} ** ({b} - 1.0) * {x}" if not y else f"{b} * {a} ** ({b} - 1.0) * {x}")
+                    terms.append(f"{_dpow(a, b)} * {x}")
                 if y:
                     terms.append(f"({t} * math.log({a}) * {y} if {a} > 0.0 else 0.0)")
                 s = " + ".join(terms)
@@ -616,7 +620,7 @@ class _Func:
             a, b = vals
             da, db = ders
             if fname == "pow":
-                ga, gb = f"({b} * math.pow({a}, {b} - 1.0))", f"({t} * math.log({a}) if {a} > 0.0 else 0.0)"
+                ga, gb = _dpow(a, b), f"({t} * math.log({a}) if {a} > 0.0 else 0.0)"
             elif fname == "atan2":  # atan2(y, x)
                 q = self.tmp()
                 lines.append(f"{q} = {a} * {a} + {b} * {b}")
@@ -645,6 +649,13 @@ def _targets(node):
     for t in tg:
         out.extend(x for x in ast.walk(t) if isinstance(x, ast.Name))
     return out
+
+
+def _dpow(a: str, b: str) -> str:
+    """∂(a^b)/∂a as source: ``b·a^(b−1)``, and at ``a = 0`` its limit (0 for b > 1, 1 for b = 1, inf for
+    0 < b < 1) rather than ``0.0 ** negative``, which raises in Python (the reference engine)."""
+    return (f"({b} * {a} ** ({b} - 1.0) if {a} != 0.0 else "
+            f"(0.0 if {b} > 1.0 or {b} == 0.0 else (1.0 if {b} == 1.0 else math.inf)))")
 
 
 def _subst(rule: str, x: str, r: str) -> str:
@@ -682,7 +693,10 @@ def _module_source(tr: _Func, fsrc: str) -> str:
             head.append(f"from {cp.__module__} import {cp.__name__} as {gname}")
     head.append("")
     head.append("")
-    head.append('@numba.njit(cache=True, error_model="numpy", nogil=True, inline="always")')
+    # inline="never": numba's IR inlining of a twin and its callees (f_conductor's 280 lines once per channel)
+    # took 217 s to compile one microfacet configuration cold on the development machine; compiled
+    # separately (each twin once, shared by every configuration), 56 s, and 10-18 s for the next ones
+    head.append('@numba.njit(cache=True, error_model="numpy", nogil=True)')
     return "\n".join(head) + "\n" + fsrc
 
 
