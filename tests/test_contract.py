@@ -171,7 +171,22 @@ def special_pairs() -> tuple[np.ndarray, np.ndarray]:
     return np.array(wi), np.array(wo)
 
 
-SPECIAL_WI, SPECIAL_WO = special_pairs()
+def grazing_pairs(z: float = 1e-12) -> tuple[np.ndarray, np.ndarray]:
+    """Both directions at elevation ``z`` with azimuths 0-360° apart in 10° steps (issue 31).
+
+    Near-opposite azimuths make the half vector's ``h_z`` ~ z/|wi + wo| a few times ``z``: at
+    z = 1e-12 its fourth power is a float32 subnormal (Beckmann D's 0/0 in float32, found at
+    wi = (-0.7768, 0.6298, 1e-12), wo = (0.9575, -0.2885, 1e-12)); that pair is included."""
+    wi = [_grazing(17.0 * k, z) for k in range(36)]
+    wo = [_grazing(17.0 * k + 10.0 * k, z) for k in range(36)]
+    a = np.array([-0.7768, 0.6298, 1e-12])
+    b = np.array([0.9575, -0.2885, 1e-12])
+    wi.append(a / np.linalg.norm(a))
+    wo.append(b / np.linalg.norm(b))
+    return np.array(wi), np.array(wo)
+
+
+SPECIAL_WI, SPECIAL_WO = (np.concatenate(x) for x in zip(special_pairs(), grazing_pairs(), grazing_pairs(1e-20)))
 
 
 def random_pairs(seed: int, n: int = 128) -> tuple[np.ndarray, np.ndarray]:
@@ -290,14 +305,18 @@ def test_random_parameters_and_directions(name):
 
     @SETTINGS
     @given(params=params_strategy(spec), seed=st.integers(0, 2**32 - 1), extra=st.lists(
-        st.tuples(st.floats(0, 180), st.floats(0, 360), st.floats(0, 180), st.floats(0, 360)), max_size=4))
-    def run(params, seed, extra):
+        st.tuples(st.floats(0, 180), st.floats(0, 360), st.floats(0, 180), st.floats(0, 360)), max_size=4),
+        grazing=st.lists(st.tuples(st.floats(0, 360), st.floats(0, 360), st.floats(-40.0, -1.0)), max_size=4))
+    def run(params, seed, extra, grazing):
         m = _model_or_reject(name, params)
         wi, wo = random_pairs(seed, 64)
         if extra:
             e = np.array(extra)
             wi = np.concatenate([wi, [_sph(a, b) for a, b in e[:, :2]]])
             wo = np.concatenate([wo, [_sph(a, b) for a, b in e[:, 2:]]])
+        if grazing:  # both directions at one tiny elevation 10^e, any azimuths (issue 31)
+            wi = np.concatenate([wi, [_grazing(a, 10.0 ** e) for a, _, e in grazing]])
+            wo = np.concatenate([wo, [_grazing(b, 10.0 ** e) for _, b, e in grazing]])
         wi = np.concatenate([wi, SPECIAL_WI])
         wo = np.concatenate([wo, SPECIAL_WO])
         check_both_dtypes(m, wi, wo)

@@ -127,6 +127,16 @@ class BRDF:
 
         return evaluate(self, wi, wo)
 
+    def eval_grad(self, wi, wo):
+        """``(f, grads)``: ``f`` as :meth:`eval` gives it, ``grads`` a dict from each continuous parameter's
+        name to ``∂f/∂param``, shape ``(..., 3)`` for a scalar and ``(..., 3, 3)`` for an RGB parameter
+        (``[..., channel_out, channel_in]``). Exact (forward mode over the kernel's own source,
+        :mod:`brdfkit.engine.forward`); at a ``min``/``max``/clamp or branch, the derivative of the branch
+        taken. ValueError for a model without a kernel (SPEC.md, "Gradients")."""
+        from ..engine.grad import eval_grad
+
+        return eval_grad(self, wi, wo)
+
     def kernel_args(self):
         """``(p, c)`` for :attr:`kernel`: float64 numeric and int64 choice arrays (see :mod:`brdfkit.engine`).
 
@@ -157,6 +167,7 @@ class BRDF:
             p = np.ascontiguousarray(vals, dtype=np.float64)
             c = np.ascontiguousarray(ints if ints else [0], dtype=np.int64)
             hit = self._cache[key] = (p, c)
+        self._cache["_pack_numeric"] = numeric  # the layout of p, for eval_grad (brdfkit.engine.grad)
         return hit
 
     def _eval(self, wi: np.ndarray, wo: np.ndarray, p: dict[str, Any]) -> np.ndarray:  # pragma: no cover

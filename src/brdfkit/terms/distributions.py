@@ -91,15 +91,18 @@ def d_beckmann_slopes(hx, hy, hz, ax, ay):
     """Beckmann D without the 1/π: ``exp(−(h_x²/α_x² + h_y²/α_y²)/h_z²) / (α_x α_y h_z⁴)``.
 
     Cook & Torrance (1982, eq. 4) for α_x = α_y = m. 0 for ``h_z <= 0``, and 0
-    where ``h_z⁴`` underflows (the exponential has underflowed long before: for
-    α ≤ 1 and h_z < 1e-70, e > 1e140), so never 0/0.
+    where the denominator ``α_x α_y h_z⁴`` underflows (the exponential has underflowed
+    long before: for α ≤ 1 and h_z < 1e-70, e > 1e140), so never 0/0. The test is on
+    the whole denominator, not on ``h_z⁴`` alone: in the float32 twin ``h_z⁴`` of a
+    grazing half vector (h_z ~ 5e-12) is a subnormal that ``α_x α_y`` then rounds to 0
+    (issue 31: NaN at z = 1e-12).
     """
     hz2 = hz * hz
-    hz4 = hz2 * hz2
-    if hz <= 0.0 or hz4 <= 0.0:
+    den = ax * ay * (hz2 * hz2)
+    if hz <= 0.0 or den <= 0.0:
         return 0.0
     e = slope2(hx, hy, ax, ay) / hz2
-    return math.exp(-e) / (ax * ay * hz4)
+    return math.exp(-e) / den
 
 
 @jit
@@ -113,11 +116,11 @@ def d_beckmann_cook(cos_h, m):
     """Cook & Torrance's (1982, eq. 4) ``exp(−(tan α/m)²)/(m² cos⁴α)`` from ``cos α``; 0 for ``cos α <= 0``."""
     c = min(cos_h, 1.0)
     c2 = c * c
-    c4 = c2 * c2
-    if c <= 0.0 or c4 <= 0.0:
-        return 0.0  # the exponential has underflowed long before cos⁴α does (m ≤ 1)
+    den = m * m * (c2 * c2)
+    if c <= 0.0 or den <= 0.0:
+        return 0.0  # the exponential has underflowed long before m² cos⁴α does (m ≤ 1)
     t2 = (1.0 - c2) / c2
-    return math.exp(-t2 / (m * m)) / (m * m * c4)
+    return math.exp(-t2 / (m * m)) / den
 
 
 @jit
