@@ -96,7 +96,7 @@ def test_measured_data_takes_no_parameters(merl_file):
 
 
 def test_kinds_can_be_restricted():
-    with pytest.raises(ValueError, match="ward: expected a built-in measured material or a MERL .binary file or an RGL .bsdf file, got a registered model"):
+    with pytest.raises(ValueError, match="ward: expected a built-in measured material or a MERL .binary file or a MERL or UTIA .bin file or an RGL .bsdf file, got a registered model"):
         sources.resolve("ward", kinds=sources.MEASURED)
 
 

@@ -79,7 +79,16 @@ def fit(name: str, measured, fixed=None, metric: str = "ngan", **kw):
     return _f(name, measured, fixed=fixed, metric=metric, **kw)
 
 
-__all__ += ["load_merl", "save_merl", "material", "materials", "fit"]
+def tabulate(source, path, format=None, **kw):
+    """Write any model as a MERL ``.binary`` or RGL ``.bsdf`` file (``format`` "merl" or "rgl", else
+    told by the suffix); returns what was written and its tabulation error.
+    See :mod:`brdfkit.measured.tabulation`."""
+    from .measured.tabulation import tabulate as _f
+
+    return _f(source, path, format, **kw)
+
+
+__all__ += ["load_merl", "save_merl", "material", "materials", "fit", "tabulate"]
 
 
 # -- interchange (brdfkit.interchange; imported on first use) -----------------------

@@ -63,6 +63,7 @@ COMMANDS: dict[str, str] = {
     "check": "brdfkit.analysis.commands",
     "plot": "brdfkit.analysis.commands",
     "fit": "brdfkit.measured.commands",
+    "tabulate": "brdfkit.measured.commands",
     "render": "brdfkit.render.commands",
     "gallery": "brdfkit.render.commands",
     "serve": "brdfkit.web.commands",

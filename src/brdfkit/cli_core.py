@@ -111,13 +111,14 @@ def measured_info(name: str, m: Any) -> dict[str, Any]:
     title = {
         "NeuralBRDF": "built-in measured material (Neural-BRDF network trained on the measurement)",
         "MERLBRDF": "measured material from a MERL .binary table (90 x 90 x 180 bins)",
+        "UTIABRDF": "measured material from a UTIA .bin table (6 x 48 x 6 x 48, Filip & Vavra 2014)",
     }.get(kind, "measured material")
     return {
         "name": getattr(m, "label", None) or name,
         "title": title,
         "kind": kind,
         "source": getattr(m, "source", "") or getattr(m, "label", None) or name,
-        "isotropic": True,
+        "isotropic": bool(getattr(m, "isotropic", True)),
         "params": [],
     }
 
@@ -128,7 +129,8 @@ def _measured_info(name: str, m: Any, json_: bool) -> None:
         print_json(data)
         return
     con = _console()
-    con.print(f"{data['name']}: {data['title']} (isotropic)", markup=False, soft_wrap=True)
+    iso = "isotropic" if data["isotropic"] else "anisotropic"
+    con.print(f"{data['name']}: {data['title']} ({iso})", markup=False, soft_wrap=True)
     if data["source"] != data["name"]:
         con.print(f"Source: {data['source']}", markup=False, soft_wrap=True)
     con.print(

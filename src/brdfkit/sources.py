@@ -12,6 +12,8 @@ Kinds of source, in the order they are tried
 ``brdf``      a Disney BRDF Explorer ``.brdf`` file (its GLSL); takes parameters
 ``fit``       a fit's JSON (``brdfkit fit ... --json > fit.json``); parameters override the fitted ones
 ``merl``      a MERL ``.binary`` file (Matusik et al. 2003); also any existing file of another suffix
+``bin``       a ``.bin`` file, told by content: UTIA (Filip & Vávra 2014; headerless, exactly
+              1 990 656 bytes) or else MERL (12-byte header)
 ``rgl``       an RGL ``.bsdf`` file (Dupuy & Jakob 2018, as Mitsuba 3's ``measured`` reads it)
 
 File kinds are chosen by suffix (:data:`FILE_KINDS`, case-insensitive). Measured
@@ -39,9 +41,9 @@ from .params import parse_assignments
 #: kinds that take parameters (a parameter table to parse ``-p`` against)
 PARAMETRIC = ("model", "brdf", "fit")
 #: kinds that are measured data (no parameters)
-MEASURED = ("material", "merl", "rgl")
+MEASURED = ("material", "merl", "bin", "rgl")
 #: kinds read from a file
-FILES = ("brdf", "fit", "merl", "rgl")
+FILES = ("brdf", "fit", "merl", "bin", "rgl")
 
 
 @dataclass(frozen=True)
@@ -109,6 +111,20 @@ def _build_merl(path: str, params: dict) -> BRDF:
     return load_merl(path)
 
 
+def _build_bin(path: str, params: dict) -> BRDF:
+    """A ``.bin`` file: UTIA (headerless, exactly 3·6·48·6·48 float64) or MERL (12-byte 90,90,180 header)."""
+    from .measured.utia import FILE_BYTES, load_utia
+
+    if os.path.isfile(path) and os.path.getsize(path) == FILE_BYTES:
+        with open(path, "rb") as fh:
+            head = fh.read(12)
+        if head != b"Z\0\0\0Z\0\0\0\xb4\0\0\0":  # MERL's int32 header 90, 90, 180
+            return load_utia(path)
+    from .measured.merl import load_merl
+
+    return load_merl(path)
+
+
 def _build_rgl(path: str, params: dict) -> BRDF:
     from .measured.rgl import load_rgl
 
@@ -147,11 +163,12 @@ _BUILDERS: dict[str, Callable[[str, dict], BRDF]] = {
     "brdf": _build_brdf,
     "fit": _build_fit,
     "merl": _build_merl,
+    "bin": _build_bin,
     "rgl": _build_rgl,
 }
 
 #: file suffix (lower case) -> kind. A reader of a new format adds its suffix here and its builder above.
-FILE_KINDS: dict[str, str] = {".brdf": "brdf", ".json": "fit", ".binary": "merl", ".bin": "merl", ".bsdf": "rgl"}
+FILE_KINDS: dict[str, str] = {".brdf": "brdf", ".json": "fit", ".binary": "merl", ".bin": "bin", ".bsdf": "rgl"}
 #: what an existing file of no known suffix is read as (MERL's reader checks its header and size)
 DEFAULT_FILE_KIND = "merl"
 
@@ -277,6 +294,7 @@ def load_measured(path: str | os.PathLike) -> BRDF:
 _MISSING = {
     "brdf": "no such .brdf file",
     "merl": "no such MERL file",
+    "bin": "no such .bin file (MERL or UTIA)",
     "rgl": "no such RGL .bsdf file",
     "fit": "no such file (a fit's JSON: brdfkit fit ... --json > FILE)",
     None: "no such file (nor a model or a built-in measured material: see `brdfkit list`, `brdfkit list --measured`)",
@@ -289,6 +307,7 @@ _KIND_WORDS = {
     "brdf": "a BRDF Explorer .brdf file",
     "fit": "a fit's JSON",
     "merl": "a MERL .binary file",
+    "bin": "a MERL or UTIA .bin file",
     "rgl": "an RGL .bsdf file",
 }
 

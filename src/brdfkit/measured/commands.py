@@ -3,6 +3,11 @@
     brdfkit fit merl/gold-metallic-paint --model ward --json
     brdfkit fit my.binary --model microfacet -p distribution=ggx -p fresnel=schlick --report out/
     brdfkit fit --all-measured --set merl --model blinn-phong --model ward --out docs/measured
+
+``brdfkit tabulate``: write any model as a measured file (MERL ``.binary``, RGL ``.bsdf``).
+
+    brdfkit tabulate microfacet -p alpha=0.2 --format rgl -o ggx.bsdf
+    brdfkit tabulate merl/gold-metallic-paint -o gold.binary --json
 """
 
 from __future__ import annotations
@@ -83,6 +88,8 @@ def parse_model_spec(text: str) -> tuple[str, str, list[str]]:
 
 
 def register(app: typer.Typer) -> None:
+    _register_tabulate(app)
+
     @app.command("fit")
     def fit_cmd(
         source: Optional[str] = typer.Argument(
@@ -136,6 +143,34 @@ def register(app: typer.Typer) -> None:
         _single(source, name, list(items) + list(param), metric, starts, n_samples, seed, as_json, report, lobes)
 
 
+def _tabulate_cmd(source, param, fmt, out, as_json, resolution, n_theta, n_phi, ndf_resolution, description):
+    from ..sources import from_cli
+    from .tabulation import tabulate
+
+    if out is None:
+        raise ValueError("missing -o PATH: the file to write (.bsdf for rgl, .binary for merl)")
+    kw = dict(resolution=resolution, n_theta=n_theta, n_phi=n_phi, ndf_resolution=ndf_resolution,
+              description=description)
+    # the request (format, options, output path) is checked before the source is read
+    from .tabulation import FORMATS, _format_of, _rgl_options
+    from ..fileio import check_output_path
+
+    fmt = _format_of(out, fmt)
+    _rgl_options(fmt, dict(kw, isotropic=None))
+    check_output_path(out, what=f"{fmt.upper()} file", suffixes=(FORMATS[fmt],))
+    model = from_cli(source, param)
+    res = tabulate(source, out, fmt, model=model, progress=not as_json, **kw)
+    if as_json:
+        print_json(res.to_json())
+        return
+    sh = res.shape
+    size = (f"{sh['n_phi']} x {sh['n_theta']} incident directions, {sh['resolution']}^2 samples each"
+            if res.format == "rgl" else "90 x 90 x 180 bins")
+    typer.echo(f"wrote {res.path} ({res.format}, {res.bytes / 1e6:.2f} MB, {size}) in {res.seconds:.1f} s")
+    if res.error is not None:
+        typer.echo(f"  tabulation error {100 * res.error:.3g} % ({res.error_measure}, {res.error_pairs} pairs)")
+
+
 def _single(source, model_name, param, metric, starts, samples, seed, as_json, report, lobes=1) -> None:
     from .optimise import fit
     from .samples import resolve_source
@@ -163,6 +198,26 @@ def _single(source, model_name, param, metric, starts, samples, seed, as_json, r
         typer.echo("  at a fitting bound: " + ", ".join(res.at_bound))
     if report:
         typer.echo(f"  report: {out['report']['index']}")
+
+
+def _register_tabulate(app: typer.Typer) -> None:
+    @app.command("tabulate")
+    def tabulate_cmd(
+        source: str = typer.Argument(..., help="any model: a name (brdfkit list), a built-in material, "
+                                               "a .brdf, a fit's .json, a MERL .binary or an RGL .bsdf file"),
+        param: List[str] = typer.Option([], "--param", "-p", help="a parameter of the model: name=value (repeatable)"),
+        fmt: Optional[str] = typer.Option(None, "--format", "-f", help="merl or rgl (default: told by the suffix of -o)"),
+        out: Optional[str] = typer.Option(None, "--out", "-o", help="the file to write: .binary (merl) or .bsdf (rgl)"),
+        as_json: bool = typer.Option(False, "--json", help="print a JSON summary (path, format, sizes, error)"),
+        resolution: Optional[int] = typer.Option(None, "--resolution", help="rgl: samples per side of each table (64)"),
+        n_theta: Optional[int] = typer.Option(None, "--n-theta", help="rgl: incident elevations (32)"),
+        n_phi: Optional[int] = typer.Option(None, "--n-phi",
+                                            help="rgl: incident azimuths of an anisotropic model (10 per quarter turn)"),
+        ndf_resolution: Optional[int] = typer.Option(None, "--ndf-resolution", help="rgl: NDF nodes per side (64)"),
+        description: Optional[str] = typer.Option(None, "--description", help="rgl: the file's description text"),
+    ) -> None:
+        """Write any model as a measured file: MERL .binary or RGL .bsdf (Mitsuba 3's `measured`)."""
+        _tabulate_cmd(source, param, fmt, out, as_json, resolution, n_theta, n_phi, ndf_resolution, description)
 
 
 def _batch(models, param, metric, starts, samples, seed, set_name, limit, out, as_json, lobes=1,

@@ -232,10 +232,11 @@ def fit(
     t0 = time.perf_counter()
     is_table = _check_options(metric, starts, samples, lobes)
     cls, fixed = _model_class(name, lobes, fixed)
-    packer = ParamPacker(cls, fixed)
     if data is None:
         data = table(measured, max_theta_deg) if is_table else sample(measured, n=samples, seed=seed,
                                                                       max_theta_deg=max_theta_deg)
+    # x/y pairs (alpha_x/alpha_y, …) share one value only when the data are isotropic
+    packer = ParamPacker(cls, fixed, tie_isotropic=data.isotropic)
     search = subsample(data, TABLE_SEARCH_SAMPLES, seed) if is_table else data
     T = transform(metric)
     residuals = residual_fn(packer, search, T, metric)

@@ -1,4 +1,4 @@
-"""The progress of one fit: a transient bar of its starts on a terminal, and/or a callback.
+"""The progress of one fit (or one tabulation): a transient bar of its steps on a terminal, and/or a callback.
 
 The bar is drawn on standard error, and only when that is a terminal: the fit's own output
 (``brdfkit fit``'s text or JSON on standard output) stays exactly what it prints (rich's live
@@ -11,8 +11,8 @@ from contextlib import contextmanager
 from typing import Callable, Iterator
 
 
-def _bar(title: str, total: int):
-    """A started rich progress bar of ``total`` starts on a terminal's standard error, and its
+def _bar(title: str, total: int, unit: str = "starts"):
+    """A started rich progress bar of ``total`` steps (named ``unit``) on a terminal's standard error, and its
     task; ``None`` when standard error is not a terminal."""
     from rich.console import Console
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
@@ -21,7 +21,7 @@ def _bar(title: str, total: int):
     if not console.is_terminal:
         return None
     bar = Progress(
-        TextColumn(title), BarColumn(), TextColumn("{task.completed}/{task.total} starts"),
+        TextColumn(title), BarColumn(), TextColumn("{task.completed}/{task.total} " + unit),
         TimeElapsedColumn(), console=console, transient=True,
     )
     bar.start()
@@ -29,14 +29,14 @@ def _bar(title: str, total: int):
 
 
 @contextmanager
-def fit_progress(progress: bool | Callable[[int, int], None], title: str, total: int
-                 ) -> Iterator[Callable[[int], None]]:
+def fit_progress(progress: bool | Callable[[int, int], None], title: str, total: int,
+                 unit: str = "starts") -> Iterator[Callable[[int], None]]:
     """``step(done)``, to call as each of ``total`` steps (local starts, a polish) ends.
 
     ``progress``: ``True`` for the bar (titled ``title``), a callable ``(done, total)`` called at
     every step, or ``False`` for neither. The bar is taken down on leaving, also on an error."""
     callback = progress if callable(progress) else None
-    shown = _bar(title, total) if progress is True else None
+    shown = _bar(title, total, unit) if progress is True else None
 
     def step(done: int) -> None:
         if shown is not None:

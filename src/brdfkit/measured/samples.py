@@ -37,6 +37,8 @@ class Samples:
     f: np.ndarray
     w: np.ndarray
     source: str = ""
+    #: False for anisotropic data (UTIA, anisotropic RGL): a fitted model's x/y pairs are then left untied
+    isotropic: bool = True
 
     @property
     def cos_i(self) -> np.ndarray:
@@ -61,8 +63,7 @@ def _source_label(model: BRDF) -> str:
 def sample(measured: Any, n: int = 3000, seed: int = 0, max_theta_deg: float = 80.0) -> Samples:
     """``n`` weighted samples of a measured material / model (see the module docstring)."""
     model = resolve_source(measured)
-    if not getattr(model, "isotropic", True):
-        raise ValueError(f"{_source_label(model)}: fitting needs isotropic measured data")
+    # φh is drawn uniformly on [0, 2π) below, so anisotropic data (UTIA, anisotropic RGL) are sampled as well
     if not (0 < max_theta_deg <= 90):
         raise ValueError(f"max_theta_deg must be in (0, 90], got {max_theta_deg}")
     if n < 16:
@@ -115,25 +116,30 @@ def sample(measured: Any, n: int = 3000, seed: int = 0, max_theta_deg: float = 8
     f = np.concatenate(f_l)
     if not np.isfinite(f).all():
         raise ValueError(f"{_source_label(model)}: measured values are not finite")
-    return Samples(np.concatenate(wi_l), np.concatenate(wo_l), f, w / w.mean(), _source_label(model))
+    return Samples(np.concatenate(wi_l), np.concatenate(wo_l), f, w / w.mean(), _source_label(model),
+                   bool(getattr(model, "isotropic", True)))
 
 
 def table(measured: Any, max_theta_deg: float = 80.0) -> Samples:
     """Every measured bin as a sample (``samples="table"``): MERL's 90 × 90 × 180 bin centres with
-    both directions within ``max_theta_deg`` of the normal, φh = 0 (the data are isotropic),
+    both directions within ``max_theta_deg`` of the normal, φh = 0 for isotropic data (uniformly
+    random φh per bin, seed 0, for anisotropic data such as UTIA),
     weighted as :func:`sample` weights them. From a MERL table the values are the table's (bins
     marked missing are left out); from any other isotropic model (a built-in material) the model
     is evaluated at the bin centres."""
     model = resolve_source(measured)
-    if not getattr(model, "isotropic", True):
-        raise ValueError(f"{_source_label(model)}: fitting needs isotropic measured data")
     if not (0 < max_theta_deg <= 90):
         raise ValueError(f"max_theta_deg must be in (0, 90], got {max_theta_deg}")
     cos_max = math.cos(math.radians(max_theta_deg)) if max_theta_deg < 90 else 0.0
     th, td, pd = bin_centres()
     I, J, K = np.meshgrid(np.arange(RES_THETA_H), np.arange(RES_THETA_D), np.arange(RES_PHI_D), indexing="ij")
     I, J, K = I.ravel(), J.ravel(), K.ravel()
-    wi, wo = from_rusinkiewicz(th[I], np.zeros(I.size), td[J], pd[K])
+    # isotropic data: φh = 0; anisotropic data: φh drawn uniformly per bin (fixed seed), so every azimuth counts
+    if getattr(model, "isotropic", True):
+        ph = np.zeros(I.size)
+    else:
+        ph = np.random.default_rng(0).random(I.size) * 2 * np.pi
+    wi, wo = from_rusinkiewicz(th[I], ph, td[J], pd[K])
     ok = (wi[:, 2] > cos_max) & (wo[:, 2] > cos_max)
     if isinstance(model, MERLBRDF):
         v = np.moveaxis(model.table[:, I, J, K], 0, -1)
@@ -150,7 +156,7 @@ def table(measured: Any, max_theta_deg: float = 80.0) -> Samples:
     u = (I[idx] + 0.5) / RES_THETA_H
     w = np.sin(th[I[idx]]) * (np.pi * u) * np.sin(td[J[idx]]) * np.cos(td[J[idx]])
     return Samples(np.ascontiguousarray(wi[idx]), np.ascontiguousarray(wo[idx]), fv, w / w.mean(),
-                   _source_label(model))
+                   _source_label(model), bool(getattr(model, "isotropic", True)))
 
 
 def subsample(data: Samples, n: int, seed: int = 0) -> Samples:
@@ -161,7 +167,7 @@ def subsample(data: Samples, n: int, seed: int = 0) -> Samples:
     rng = np.random.default_rng(seed)
     idx = np.sort(rng.choice(len(data), size=n, replace=False))
     w = data.w[idx]
-    return Samples(data.wi[idx], data.wo[idx], data.f[idx], w / w.mean(), data.source)
+    return Samples(data.wi[idx], data.wo[idx], data.f[idx], w / w.mean(), data.source, data.isotropic)
 
 
 __all__ = ["Samples", "resolve_source", "sample", "table", "subsample"]
