@@ -11,8 +11,10 @@ starts: the parameters' defaults plus the best of a few dozen random points of t
 parameter space (multi-start, so a local minimum does not decide); the best result wins. A
 start that enters the basin of a minimum an earlier start converged to (within
 :data:`JOIN_XTOL` of it in every free value, :data:`JOIN_RTOL` in cost) stops there; its
-``start_errors`` entry is the error it had then. The Jacobian is by forward differences,
-cheaper where the model allows (:mod:`brdfkit.measured.jacobian`). A ``samples="table"``
+``start_errors`` entry is the error it had then. The Jacobian is the model's exact one, from
+its ``eval_grad`` (:mod:`brdfkit.measured.exact_jacobian`); for a model with no gradient (a
+``.brdf`` file's GLSL, ``multiscatter``) it is by forward differences, cheaper where the model
+allows (:mod:`brdfkit.measured.jacobian`). A ``samples="table"``
 fit searches on :data:`TABLE_SEARCH_SAMPLES` of the bins and polishes the best start on all
 of them (:func:`_polish`).
 """
@@ -28,6 +30,7 @@ from typing import Any, Callable, Mapping
 import numpy as np
 
 from ..models.base import BRDF
+from .exact_jacobian import exact_jacobian
 from .jacobian import channel_groups, constant_columns, jacobian, probe_columns
 from .lobes import two_lobe
 from .metrics import METRICS, error, transform
@@ -43,6 +46,12 @@ from .samples import Samples, sample, subsample, table
 #: rule of clustering multi-start methods, Rinnooy Kan & Timmer, Math. Programming 39, 1987)
 JOIN_XTOL = 1e-2
 JOIN_RTOL = 1e-3
+
+#: use the model's exact Jacobian (its ``eval_grad``, :mod:`brdfkit.measured.exact_jacobian`)
+#: where it has one; False: forward differences for every model, as before issue 31. Off by default
+#: until a fit with it is shown no worse everywhere: on (one test's 800-sample microfacet fit) the
+#: best start stopped 1.4e-6 (relative) above the finite-difference fit's loss
+EXACT_JACOBIAN = False
 
 
 class _Joined(Exception):
@@ -93,12 +102,14 @@ class _Start:
         return self(x)
 
 
-def _local(residuals, x0, packer, max_nfev, tol, known=(), const=None, groups=None):
+def _local(residuals, x0, packer, max_nfev, tol, known=(), const=None, groups=None, exact=None):
     """A bounded least-squares run from ``x0``: ``(x, cost = Σ r², evaluations, joined)``.
 
     ``known``: ``(x, cost)`` of minima found by earlier starts; a run that enters one's
     basin (:data:`JOIN_XTOL`, :data:`JOIN_RTOL`) stops there. ``const``: the
-    :func:`constant_columns` of the Jacobian; ``groups``: its :func:`channel_groups`."""
+    :func:`constant_columns` of the Jacobian; ``groups``: its :func:`channel_groups`.
+    ``exact``: the model's exact Jacobian (:func:`exact_jacobian`), used instead of differences;
+    each of its calls counts as one evaluation."""
     from scipy.optimize import least_squares
 
     x0 = np.clip(x0, packer.lb, packer.ub)
@@ -110,7 +121,10 @@ def _local(residuals, x0, packer, max_nfev, tol, known=(), const=None, groups=No
     diff_step = getattr(packer.cls, "fit_diff_step", None)
     fn = _Start(residuals, packer, list(known))
     grouped = groups is not None and any(len(g) > 1 for g in groups)
-    jac = jacobian(fn, packer, const or {}, groups if grouped else None) if const or grouped else "2-point"
+    if exact is not None:
+        jac = _counted(exact, fn)
+    else:
+        jac = jacobian(fn, packer, const or {}, groups if grouped else None) if const or grouped else "2-point"
     try:
         res = least_squares(
             fn, x0, jac=jac, bounds=(packer.lb, packer.ub), method="trf", x_scale="jac", tr_solver="lsmr",
@@ -119,6 +133,16 @@ def _local(residuals, x0, packer, max_nfev, tol, known=(), const=None, groups=No
     except _Joined as j:
         return j.x, j.cost, fn.nfev, True
     return res.x, float(2 * res.cost), fn.nfev, False
+
+
+def _counted(exact, fn: _Start):
+    """``exact``, each call counted in ``fn.nfev`` (a gradient evaluation is one evaluation)."""
+
+    def jac(x: np.ndarray) -> np.ndarray:
+        fn.nfev += 1
+        return exact(x)
+
+    return jac
 
 
 #: a residual vector of at most this many samples is evaluated on one thread: the engine's
@@ -247,7 +271,7 @@ def fit(
                          time.perf_counter() - t0, sorted(packer.fixed_names), [], [err], lobes=lobes,
                          search_samples=len(search))
     # from here on the model is built from the free values
-    plan = _plan_starts(packer, residuals, len(search), seed, candidates, starts)
+    plan = _plan_starts(packer, residuals, len(search), seed, candidates, starts, search, metric)
     nfev = plan.evaluations
     total = len(plan.chosen) + (1 if search is not data else 0)
     best_x, best_cost = None, math.inf
@@ -257,7 +281,7 @@ def fit(
         for n_done, x0 in enumerate(plan.chosen, 1):
             with _engine_threads(len(search)):
                 x, cst, used, joined = _local(residuals, x0, packer, max_nfev or 100, tol, known, plan.const,
-                                              plan.groups)
+                                              plan.groups, plan.exact)
             nfev += used
             start_errors.append(math.sqrt(cst))
             if not joined:
@@ -318,13 +342,16 @@ class _StartPlan:
     chosen: list[np.ndarray]  # the starting points, the defaults first
     const: dict[int, np.ndarray]  # constant_columns
     groups: list[list[int]] | None  # channel_groups
+    exact: Callable[[np.ndarray], np.ndarray] | None  # exact_jacobian, None where the model has no gradient
     evaluations: int  # residual evaluations spent choosing (counted as before: an upper bound)
 
 
-def _plan_starts(packer: ParamPacker, residuals, n_samples: int, seed: int, candidates: int, starts: int
-                 ) -> _StartPlan:
+def _plan_starts(packer: ParamPacker, residuals, n_samples: int, seed: int, candidates: int, starts: int,
+                 data: Samples | None = None, metric: str = "ngan") -> _StartPlan:
     """Freeze the unused slots, then take the defaults and the best ``starts - 1`` of ``candidates``
-    random points (by cost), and probe the Jacobian's columns at the first two of them."""
+    random points (by cost); the model's exact Jacobian on ``data`` (the residuals' samples) where
+    it has one (and :data:`EXACT_JACOBIAN`), else probe the Jacobian's columns at the first two
+    of the points for the differences' shortcuts."""
     rng = np.random.default_rng(seed + 1)
     nfev = 2 * (len(packer) + 1)  # freeze_unused: at most 2 points × (base + one probe per slot)
     with _engine_threads(n_samples):
@@ -335,13 +362,14 @@ def _plan_starts(packer: ParamPacker, residuals, n_samples: int, seed: int, cand
         costs = np.array([float(r @ r) for r in map(residuals, cand)])
         # Jacobian columns known once for all (a float32-evaluated model's differences are too noisy)
         const, groups = {}, None
-        if not getattr(packer.cls, "fit_diff_step", None):
+        exact = exact_jacobian(packer, data, metric) if EXACT_JACOBIAN and data is not None else None
+        if exact is None and not getattr(packer.cls, "fit_diff_step", None):
             probes = probe_columns(residuals, packer, cand[:2])
             nfev += probes.evaluations
             const = constant_columns(residuals, packer, cand[:2], probes)
             groups = channel_groups(residuals, packer, cand[:2], const, probes)
     nfev += len(cand)
     order = [0] + [int(i) for i in np.argsort(costs) if i != 0]
-    return _StartPlan([cand[i] for i in order[:starts]], const, groups, nfev)
+    return _StartPlan([cand[i] for i in order[:starts]], const, groups, exact, nfev)
 
-__all__ = ["fit", "JOIN_XTOL", "JOIN_RTOL", "TABLE_SEARCH_SAMPLES", "SERIAL_SAMPLES", "POLISH_ITERATIONS"]
+__all__ = ["fit", "EXACT_JACOBIAN", "JOIN_XTOL", "JOIN_RTOL", "TABLE_SEARCH_SAMPLES", "SERIAL_SAMPLES", "POLISH_ITERATIONS"]
