@@ -6,6 +6,7 @@ smallest that keep the standard error several times below the tolerance.
 
 from __future__ import annotations
 
+import json
 import numpy as np
 import pytest
 
@@ -254,3 +255,18 @@ def test_anisotropic_masking_matches_smith(kind):
     assert np.all(est.stderr < 0.006), est.stderr
     assert np.all(np.abs(est.value - ref) < 0.02), (est.value, ref, est.stderr)
     assert ref[2] < ref[0] - 0.1  # the rougher direction masks more: the test tells x from y
+
+
+def test_gallery_makes_the_three_pictures(cli, tmp_path):
+    """``brdfkit gallery --only microsurfaces`` writes the lecture's three pictures from simulation,
+    each a PNG with something drawn on it."""
+    from PIL import Image
+
+    rc, stdout, err = cli("gallery", "--only", "microsurfaces", "-o", str(tmp_path / "g"), "--json")
+    assert rc == 0, err
+    files = json.loads(stdout)
+    assert [p.rsplit("/", 1)[-1] for p in files] == [
+        "microsurfaces-paths.png", "microsurfaces-masking.png", "microsurfaces-albedo.png"]
+    for p in files:
+        img = np.asarray(Image.open(p).convert("L"), dtype=float)
+        assert img.shape[1] > 600 and img.std() > 10, p

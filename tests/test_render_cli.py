@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import sys
 
 import numpy as np
 import pytest
@@ -171,3 +172,18 @@ def test_default_environment_only_on_the_glsl_backend(tmp_path):
     assert uses_default_environment(parsed, lights_given=False)
     assert not uses_default_environment(parsed, lights_given=False, glsl=False)
     assert not uses_default_environment(parsed, lights_given=True)
+
+
+def test_gallery_skips_a_plot_figure_that_cannot_run_here(tmp_path, capsys, monkeypatch):
+    """Where Mitsuba's llvm variant is missing the default gallery names the skipped figure on stderr
+    and makes the rest; asking for it explicitly is a one-line error (exit 1, nothing written)."""
+    from brdfkit.render import gallery
+
+    monkeypatch.setattr(gallery.FIGURES["microsurfaces"], "unavailable", lambda: "no Mitsuba here")
+    names = gallery.gallery_names(None, notify=lambda m: print(m, file=sys.stderr))
+    assert "microsurfaces" not in names and "materials" in names
+    assert "skipped figure 'microsurfaces': no Mitsuba here" in capsys.readouterr().err
+    rc = main(["gallery", "--only", "microsurfaces", "-o", str(tmp_path / "g")])
+    err = capsys.readouterr().err
+    assert rc != 0 and "cannot be made here: no Mitsuba here" in err and "Traceback" not in err
+    assert not (tmp_path / "g").exists()

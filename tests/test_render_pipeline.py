@@ -270,4 +270,8 @@ def test_pipeline_shaders_compile_as_glsl_es_300(material, where):
     vs += _read_shader("pipeline_vertex.glsl")
     fs = "#version 300 es\n" + d + (light if where == "fragment" else "precision highp float;\n")
     fs += _read_shader("pipeline_fragment.glsl")
-    ctx.program(vertex_shader=vs, fragment_shader=fs).release()
+    from brdfkit.render.context import EGLCurrent
+
+    # another test's context may be current in this worker: make this one current as the renderer does
+    with EGLCurrent(), ctx:
+        ctx.program(vertex_shader=vs, fragment_shader=fs).release()

@@ -98,7 +98,7 @@ def cross_section(path, alpha: float = 0.9, theta_deg: float = 60.0, rays: int =
     ax.legend(loc="upper right", fontsize=8, frameon=False)
     fig.tight_layout()
     with atomic_path(path) as tmp:
-        fig.savefig(tmp)
+        fig.savefig(tmp, bbox_inches="tight")  # the equal-aspect cut leaves wide margins otherwise
     plt.close(fig)
     return path
 

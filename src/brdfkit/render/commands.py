@@ -190,14 +190,11 @@ def register(app: typer.Typer) -> None:
         as_json: bool = typer.Option(False, "--json", help="print the written files as JSON"),
     ) -> None:
         """The lecture's figures as labelled images (materials, Gouraud vs Phong, ...)."""
-        from .gallery import FIGURES, run_gallery
+        from .gallery import gallery_names, run_gallery
 
         if size < 32 or size > 2048:
             raise ValueError(f"--size must be in [32, 2048], got {size}")
-        names = list(only) if only else list(FIGURES)
-        for n in names:
-            if n not in FIGURES:
-                raise ValueError(f"unknown figure {n!r}; valid figures: {', '.join(FIGURES)}")
+        names = gallery_names(only, notify=lambda m: typer.echo(f"brdfkit: {m}", err=True))
         from ..fileio import check_output_path
 
         check_output_path(out_dir, what="gallery", is_dir=True, notify=lambda m: typer.echo(f"brdfkit: {m}", err=True))

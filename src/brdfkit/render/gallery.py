@@ -19,6 +19,12 @@ Each figure is a grid of panels with a caption under every panel and a title:
 ``white-furnace``          microfacet spheres (F = 1) in a uniform white environment at increasing
                            roughness, single scattering vs the Kulla-Conty compensation: a sphere that
                            conserves energy disappears into the background
+``microsurfaces``          the lecture's three microfacet pictures made by tracing light through
+                           explicit surfaces (:mod:`brdfkit.microsurfaces.figures`): paths coloured by
+                           bounce, traced G1 beside Smith's and the V-groove formula, traced albedo
+                           split by bounce beside the Kulla-Conty compensation. Plots, not renders:
+                           three PNGs, made where Mitsuba 3's llvm variant runs (``brdfkit[measure]``)
+                           and skipped with a note elsewhere
 
 The figures lit by an environment (``cook-torrance-metals``, ``measured``, ``metals-ibl``,
 ``white-furnace``) use image-based lighting (:mod:`brdfkit.render.environment`,
@@ -263,7 +269,33 @@ def _measured() -> list[Panel]:
                   samples=IBL_SAMPLES) for name in MEASURED]
 
 
-FIGURES: dict[str, Figure] = {
+@dataclass
+class PlotFigure:
+    """A figure plotted from a simulation (matplotlib), not rendered: ``files()`` maps each PNG's name to
+    the function that writes it; ``unavailable()`` gives the reason it cannot run here, or None."""
+
+    name: str
+    title: str
+    files: Callable[[], dict[str, Callable[[Path], Path]]] = field(repr=False)
+    unavailable: Callable[[], str | None] = field(repr=False, default=lambda: None)
+
+
+def _microsurface_plots() -> dict[str, Callable[[Path], Path]]:
+    from ..microsurfaces import figures as mf
+
+    return {"microsurfaces-paths.png": mf.cross_section, "microsurfaces-masking.png": mf.masking_curves,
+            "microsurfaces-albedo.png": mf.albedo_split}
+
+
+def _microsurfaces_unavailable() -> str | None:
+    from ..microsurfaces.engines import available
+
+    if available("mitsuba-llvm"):
+        return None
+    return "it traces with Mitsuba 3's llvm_ad_rgb variant, not available here (pip install 'brdfkit[measure]'; LLVM)"
+
+
+FIGURES: dict[str, Figure | PlotFigure] = {
     f.name: f
     for f in (
         Figure("materials", "The lecture's OpenGL materials (fixed-function lighting, Gouraud shading)", 6, _materials),
@@ -275,8 +307,31 @@ FIGURES: dict[str, Figure] = {
         Figure("measured", "Measured materials (MERL, as Neural-BRDF networks) in the studio environment", 6, _measured),
         Figure("metals-ibl", "Metals (microfacet, complex index) and measured materials in the studio environment", 4, _metals_ibl),
         Figure("white-furnace", "White furnace (F = 1): single scattering loses energy, Kulla-Conty compensation restores it", 4, _white_furnace),
+        PlotFigure("microsurfaces", "Shadowing, masking and inter-reflection, traced through explicit microsurfaces",
+                   _microsurface_plots, _microsurfaces_unavailable),
     )
 }
+
+
+def gallery_names(only: Sequence[str] | None, notify: Callable[[str], None] = lambda m: None) -> list[str]:
+    """The figures to make: ``only`` (each must exist and be able to run here: a ValueError otherwise),
+    or every figure that can run here (the others named through ``notify``)."""
+    if only:
+        for n in only:
+            if n not in FIGURES:
+                raise ValueError(f"unknown figure {n!r}; valid figures: {', '.join(FIGURES)}")
+            why = getattr(FIGURES[n], "unavailable", lambda: None)()
+            if why:
+                raise ValueError(f"figure {n!r} cannot be made here: {why}")
+        return list(only)
+    names = []
+    for n, f in FIGURES.items():
+        why = getattr(f, "unavailable", lambda: None)()
+        if why:
+            notify(f"skipped figure {n!r}: {why}")
+        else:
+            names.append(n)
+    return names
 
 
 # --------------------------------------------------------------------------- drawing
@@ -391,7 +446,8 @@ def run_gallery(out_dir: str | Path, names: Sequence[str] | None = None, size: i
     out.mkdir(parents=True, exist_ok=True)
     names = list(names) if names else list(FIGURES)
     figs = [FIGURES[n] for n in names]
-    panel_lists = [f.panels() for f in figs]  # built once: measured panels load networks
+    # built once: measured panels load networks; a plot figure's steps are its files
+    panel_lists = [list(f.files().items()) if isinstance(f, PlotFigure) else f.panels() for f in figs]
     written: list[Path] = []
     mesh_cache: dict = {}
     with Progress(
@@ -405,6 +461,11 @@ def run_gallery(out_dir: str | Path, names: Sequence[str] | None = None, size: i
         task = bar.add_task("gallery", total=sum(len(p) for p in panel_lists))
         for fig, panels in zip(figs, panel_lists):
             bar.update(task, description=fig.name)
+            if isinstance(fig, PlotFigure):
+                for fname, make in panels:
+                    written.append(make(out / fname))  # each writes atomically
+                    bar.advance(task)
+                continue
             img = render_figure(fig, size, lambda: bar.advance(task), mesh_cache, panels)
             path = out / f"{fig.name}.png"
             with atomic_open(path, "wb") as fh:
