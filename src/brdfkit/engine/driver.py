@@ -72,7 +72,7 @@ def nchunks(n: int) -> int:
 _ALL_UNIT = (1.0, 1.0, 0.0, 1.0, 1.0, 0.0)
 
 
-def _unit_band(dtype, ft) -> tuple:
+def unit_band(dtype, ft) -> tuple:
     """``(lo2, hi2)``: a band of squared lengths safely inside ``|w|`` in ``[1 − tol, 1 + tol]`` (``tol`` the
     unit tolerance of the output ``dtype``), in the working precision ``ft``: the margin is far above the
     rounding of x² + y² + z² in that precision (and of the band's own rounding to it)."""
@@ -117,7 +117,7 @@ def _run_span(span: Callable, wi: np.ndarray, wo: np.ndarray, p: np.ndarray, c: 
     if serial:
         drive = _SERIAL[key]
     lim = np.float64(np.finfo(out.dtype).max)
-    lo2, hi2 = _unit_band(out.dtype, np.float64)
+    lo2, hi2 = unit_band(out.dtype, np.float64)
     bad = np.zeros(nrm.shape[0], dtype=np.int64)
     pt = param_tuple(p)
     ck = _compile_key(drive, pt, wi, wo)
@@ -216,7 +216,7 @@ def run(kernel: Callable, wi: np.ndarray, wo: np.ndarray, p: np.ndarray, c: np.n
     serial, threads = cost.serially(key, n)
     if serial:
         drive = _SERIAL[key]
-    lo2, hi2 = _unit_band(out.dtype, ft)
+    lo2, hi2 = unit_band(out.dtype, ft)
     bad = np.zeros(nrm.shape[0], dtype=np.int64)
     pt = param_tuple(p, ft)
     ck = _compile_key(drive, pt, wi, wo)

@@ -20,8 +20,10 @@ that line performs:
   tangents and which tangent components can be nonzero (a static sparsity pattern, computed by a
   fixpoint over the function's assignments: ``ks_r``'s tangent is never formed in the green channel).
 
-The kernel's parameter array ``p`` is the seed: ``p[k]`` with a constant ``k`` below ``N`` has the unit
-tangent ``e_k``; every other subscript (a table in ``p``) is a constant. The generated sources are
+The kernel's parameter array ``p`` is the seed: ``p[k]`` with a constant ``k`` in the seed set (all of
+``0 … N−1``, or the components asked for, ``eval_grad(wrt=…)``) has the unit tangent ``e_k``; every other
+subscript (another parameter, a table in ``p``) is a constant, so a twin seeded by fewer parameters
+carries fewer tangents and does less work. The generated sources are
 written to ``<cache_dir>/forward/`` and imported from there with ``cache=True``, so numba's disk
 cache holds their machine code (a new process does not recompile).
 """
@@ -98,10 +100,10 @@ _MATH_UNARY = {
 class _Func:
     """The transformation of one source function for one pattern of its arguments."""
 
-    def __init__(self, fn: Callable, arg_patterns: tuple, n: int):
+    def __init__(self, fn: Callable, arg_patterns: tuple, seeds: frozenset):
         self.fn = fn
         self.py = getattr(fn, "py_func", fn)
-        self.n = n
+        self.seeds = seeds
         src = textwrap.dedent(inspect.getsource(self.py))
         tree = ast.parse(src)
         self.fdef = tree.body[0]
@@ -230,7 +232,7 @@ class _Func:
     def _call_pats(self, call: ast.Call) -> tuple:
         obj = self._callee(call)
         pats = tuple(self._arg_pat(a) for a in call.args)
-        _, rets = forward_function(obj, pats, self.n)
+        _, rets = forward_function(obj, pats, self.seeds)
         return rets
 
     def epat(self, e) -> frozenset:
@@ -253,7 +255,7 @@ class _Func:
         if isinstance(e, ast.Subscript):
             v = e.value
             k = self.static_int(e.slice)
-            if isinstance(v, ast.Name) and self.arg_patterns.get(v.id) == P_ARRAY and k is not None and 0 <= k < self.n:
+            if isinstance(v, ast.Name) and self.arg_patterns.get(v.id) == P_ARRAY and k is not None and k in self.seeds:
                 return frozenset([k])
             return EMPTY  # a table in p, or another array: a constant
         if isinstance(e, ast.Attribute):
@@ -425,7 +427,7 @@ class _Func:
             argsrc.append(v)
             if isinstance(ap, frozenset):
                 argsrc.extend(d.get(j, "0.0") for j in sorted(ap))
-        twin, rets = forward_function(obj, tuple(pats), self.n)
+        twin, rets = forward_function(obj, tuple(pats), self.seeds)
         gname = f"_fwd_{len(self.callees)}"
         self.callees[gname] = (twin, rets)
         t = self.tmp()
@@ -718,33 +720,46 @@ def _pat_str(p) -> str:
     return "d" + "-".join(str(j) for j in sorted(p))
 
 
-def forward_function(fn: Callable, arg_patterns: tuple, n: int) -> tuple[Callable, tuple]:
+def _seed_set(seeds) -> frozenset:
+    return frozenset(range(seeds)) if isinstance(seeds, int) else frozenset(int(k) for k in seeds)
+
+
+def _seed_str(seeds: frozenset) -> str:
+    """``n17`` for all of ``0 … 16``, else ``s0-3-5``: the seeds in a generated file's name."""
+    if seeds == frozenset(range(len(seeds))):
+        return f"n{len(seeds)}"
+    return "s" + "-".join(str(k) for k in sorted(seeds))
+
+
+def forward_function(fn: Callable, arg_patterns: tuple, seeds) -> tuple[Callable, tuple]:
     """``(twin, return patterns)``: ``fn``'s forward twin for arguments whose tangent components are
     ``arg_patterns`` (a frozenset per argument, :data:`P_ARRAY` for the parameter array). Where no
-    argument carries a tangent, ``fn`` itself (its results carry none)."""
+    argument carries a tangent, ``fn`` itself (its results carry none). ``seeds``: the indices ``k`` whose
+    ``p[k]`` is differentiated (an int ``n``: all of ``0 … n−1``)."""
+    seeds = _seed_set(seeds)
     py = getattr(fn, "py_func", fn)
     if all(not (p == P_ARRAY or isinstance(p, frozenset) and p) for p in arg_patterns):
         # nothing flows in: the original, its results constants (arity from a trial analysis)
-        key = (id(py), arg_patterns, n)
+        key = (id(py), arg_patterns, seeds)
         with _LOCK:
             hit = _TWINS.get(key)
             if hit is None:
-                tr = _Func(fn, arg_patterns, n)
+                tr = _Func(fn, arg_patterns, seeds)
                 tr.analyse()
                 hit = _TWINS[key] = (fn, tuple(tr.ret or [EMPTY]))
         return hit
-    key = (id(py), arg_patterns, n)
+    key = (id(py), arg_patterns, seeds)
     with _LOCK:
         hit = _TWINS.get(key)
         if hit is not None:
             return hit
-        tr = _Func(fn, arg_patterns, n)
+        tr = _Func(fn, arg_patterns, seeds)
         try:
             fsrc = tr.generate()
         except Unsupported as e:
             msg = str(e)
             raise Unsupported(msg if msg.startswith("in ") else f"in {py.__qualname__}: {msg}") from None
-        stem = (f"fwd_{py.__module__}_{py.__name__}__n{n}__" + "_".join(_pat_str(p) for p in arg_patterns))
+        stem = (f"fwd_{py.__module__}_{py.__name__}__{_seed_str(seeds)}__" + "_".join(_pat_str(p) for p in arg_patterns))
         stem = stem.replace(".", "_")
         if len(stem) > 180:
             import hashlib
@@ -783,12 +798,12 @@ def _load(stem: str, src: str, name: str) -> Callable:
     return getattr(mod, name)
 
 
-def forward_kernel(kernel: Callable, n: int) -> tuple[Callable, tuple]:
+def forward_kernel(kernel: Callable, seeds) -> tuple[Callable, tuple]:
     """The forward twin of a model kernel ``kernel(wix, wiy, wiz, wox, woy, woz, p, c)`` seeded by
-    ``p[0..n)``: it returns ``(r, r__d…, g, g__d…, b, b__d…)``, with the tangent components of each
-    channel listed in the returned patterns."""
+    ``p[k]`` for each ``k`` in ``seeds`` (an int ``n``: ``p[0..n)``): it returns ``(r, r__d…, g, g__d…,
+    b, b__d…)``, with the tangent components of each channel listed in the returned patterns."""
     pats = (EMPTY,) * 6 + (P_ARRAY, EMPTY)
-    twin, rets = forward_function(kernel, pats, n)
+    twin, rets = forward_function(kernel, pats, seeds)
     if len(rets) != 3:
         raise Unsupported("a kernel must return three channels")
     return twin, rets

@@ -41,7 +41,8 @@ ZERO = {F}(0.0)
 
 
 @numba.njit(cache=True, error_model="numpy", nogil=True, fastmath={FM})
-def span(wi, wo, p, out, gout, lim, lo, hi):
+def span(wi, wo, p, out, gout, lim, lo2, hi2, bad, ch, lo, hi):
+    nbad = 0
     for j in range(lo, hi):
         ax = {F}(wi[j, 0])
         ay = {F}(wi[j, 1])
@@ -49,33 +50,38 @@ def span(wi, wo, p, out, gout, lim, lo, hi):
         bx = {F}(wo[j, 0])
         by = {F}(wo[j, 1])
         bz = {F}(wo[j, 2])
+        li = ax * ax + ay * ay + az * az  # the unit check of eval's drivers: pairs outside a safe band, counted
+        lo_ = bx * bx + by * by + bz * bz
+        nbad += (li >= lo2) & (li <= hi2) & (lo_ >= lo2) & (lo_ <= hi2) == False
         ok = (az > ZERO) & (bz > ZERO)
         res = kernel(ax, ay, az, bx, by, bz, p, C)
 {stores}
+    bad[ch] = nbad
 
 
 @numba.njit(cache=True, parallel=True, error_model="numpy", nogil=True, fastmath={FM})
-def drive(wi, wo, p, out, gout, lim):
+def drive(wi, wo, p, out, gout, lim, lo2, hi2, bad):
     n = wi.shape[0]
     nchunks = (n + CHUNK - 1) // CHUNK
     for ch in numba.prange(nchunks):
         lo = ch * CHUNK
-        span(wi, wo, p, out, gout, lim, lo, min(n, lo + CHUNK))
+        span(wi, wo, p, out, gout, lim, lo2, hi2, bad, ch, lo, min(n, lo + CHUNK))
 
 
 @numba.njit(cache=True, error_model="numpy", nogil=True, fastmath={FM})
-def drive_serial(wi, wo, p, out, gout, lim):
+def drive_serial(wi, wo, p, out, gout, lim, lo2, hi2, bad):
     n = wi.shape[0]
     nchunks = (n + CHUNK - 1) // CHUNK
     for ch in range(nchunks):
         lo = ch * CHUNK
-        span(wi, wo, p, out, gout, lim, lo, min(n, lo + CHUNK))
+        span(wi, wo, p, out, gout, lim, lo2, hi2, bad, ch, lo, min(n, lo + CHUNK))
 '''
 
 _LOCK = threading.Lock()
 
 
-def _stores(rets) -> str:
+def _stores(rets, col: dict) -> str:
+    """The stores of one pair's results: ``col`` maps a seeded component of ``p`` to its column of ``gout``."""
     lines = []
     k = 0
     for ch, pat in enumerate(rets):
@@ -83,7 +89,7 @@ def _stores(rets) -> str:
         lines.append(f"        keep{ch} = ok & (v{ch} < lim)")
         lines.append(f"        out[j, {ch}] = min(v{ch}, lim) if ok else ZERO")
         for i, comp in enumerate(sorted(pat)):
-            lines.append(f"        gout[j, {ch}, {comp}] = res[{k + 1 + i}] if keep{ch} else ZERO")
+            lines.append(f"        gout[j, {ch}, {col[comp]}] = res[{k + 1 + i}] if keep{ch} else ZERO")
         k += 1 + len(pat)
     return "\n".join(lines)
 
@@ -103,24 +109,47 @@ def layout(model) -> list[tuple[str, int, int]]:
     return out
 
 
-def _grad_driver(model, kernel, choices: tuple, f32: bool, n: int):
-    twin, rets = forward_kernel(kernel, n)
+def _wanted(model, lay, wrt) -> list[tuple[str, int, int]]:
+    """The part of ``lay`` that ``wrt`` asks for (None: all of it); ValueError naming an unknown name."""
+    if wrt is None:
+        return lay
+    names = [wrt] if isinstance(wrt, str) else list(wrt)
+    have = {n for n, _, _ in lay}
+    alias = {"alpha": ("alpha_x", "alpha_y")} if "alpha_x" in have and model.params.get("alpha") is not None else {}
+    want: set[str] = set()
+    for n in names:
+        if not isinstance(n, str):
+            raise ValueError(f"{model.name}: wrt must be parameter names; got {n!r}")
+        if n in alias:
+            want.update(alias[n])
+        elif n in have:
+            want.add(n)
+        else:
+            raise ValueError(f"{model.name}: no gradient with respect to {n!r} "
+                             f"(continuous parameters: {', '.join(sorted(have | set(alias)))})")
+    return [t for t in lay if t[0] in want]
+
+
+def _grad_driver(model, kernel, choices: tuple, f32: bool, seeds: tuple):
+    twin, rets = forward_kernel(kernel, seeds)
     py = getattr(kernel, "py_func", kernel)
     key = _KEY_OF[id(twin)]
     kline = "float32_twin(_k, inline=True)" if f32 else "_k"
+    col = {k: i for i, k in enumerate(seeds)}
     src = GRAD_TEMPLATE.format(module=py.__module__, name=py.__name__, key=key, kernel_line=kline,
-                               choices=repr(choices), chunk=_driver.CHUNK, stores=_stores(rets),
+                               choices=repr(choices), chunk=_driver.CHUNK, stores=_stores(rets, col),
                                F="numba.float32" if f32 else "numba.float64",
                                FM="{'contract'}" if f32 else "False")
     stem = f"grad_{key}{'__f32' if f32 else ''}__c" + "_".join(str(v) for v in choices)
-    dkey = ("grad", py.__module__, py.__name__, n, f32, choices)
+    dkey = ("grad", py.__module__, py.__name__, seeds, f32, choices)
     return _load(dkey, stem[:200], src), rets
 
 
-def _reference(kernel, n, fi, fo, p, c, out, gout, lim) -> None:
+def _reference(kernel, seeds, fi, fo, p, c, out, gout, lim) -> None:
     from .reference import pure
 
-    twin, rets = forward_kernel(kernel, n)
+    twin, rets = forward_kernel(kernel, seeds)
+    col = {k: i for i, k in enumerate(seeds)}
     k = pure(twin)
     pl = [float(x) for x in np.asarray(p, dtype=np.float64)]
     cl = [int(x) for x in np.asarray(c, dtype=np.int64)]
@@ -139,12 +168,14 @@ def _reference(kernel, n, fi, fo, p, c, out, gout, lim) -> None:
             out[j, ch] = min(v, lim)
             if v < lim:
                 for q, comp in enumerate(sorted(pat)):
-                    gout[j, ch, comp] = res[i + 1 + q]
+                    gout[j, ch, col[comp]] = res[i + 1 + q]
             i += 1 + len(pat)
 
 
-def eval_grad(model, wi, wo):
-    """``(f, grads)`` for ``model`` (see the module docstring); ValueError where the model has none."""
+def eval_grad(model, wi, wo, wrt=None):
+    """``(f, grads)`` for ``model`` (see the module docstring); ``wrt``: the parameter names to differentiate
+    (default every continuous one; fewer names, fewer tangents computed). ValueError where the model has no
+    gradient, or for a name that is not one of its continuous parameters."""
     name = model.name
     kernel = getattr(type(model), "kernel", None)
     if kernel is None:
@@ -152,11 +183,12 @@ def eval_grad(model, wi, wo):
     if model.params.get("multiscatter"):
         raise ValueError(f"{name}: no gradient with multiscatter=true (its compensation table is precomputed "
                          f"per parameter set, outside the kernel's source)")
-    lay = layout(model)
-    n = sum(s for _, _, s in lay)
+    full = layout(model)
+    lay = _wanted(model, full, wrt)
+    seeds = tuple(k for _, off, size in lay for k in range(off, off + size))
+    n = len(seeds)
     p, c = model.kernel_args()
     fi, fo, shape, dtype = prepare(name, wi, wo)
-    check_unit_flat(name, fi, fo, dtype)
     npairs = fi.shape[0]
     out = np.zeros((npairs, 3), dtype=dtype)
     gout = np.zeros((npairs, 3, n), dtype=dtype)
@@ -169,21 +201,27 @@ def eval_grad(model, wi, wo):
             ft = np.float32 if f32 else np.float64
             choices = tuple(int(v) for v in c)
             with _LOCK:
-                drive, _ = _grad_driver(model, kernel, choices, f32, n)
+                drive, _ = _grad_driver(model, kernel, choices, f32, seeds)
             pt = _driver.param_tuple(p, ft)
             w_i, w_o = _driver.read_only(fi), _driver.read_only(fo)
+            bad = np.zeros(_driver.nchunks(npairs), dtype=np.int64)
             if out.dtype != ft:  # float32 arrays through the float64 kernel: computed in float64, rounded once
                 o64 = np.zeros((npairs, 3))
                 g64 = np.zeros((npairs, 3, n))
-                _run(drive, w_i.astype(np.float64), w_o.astype(np.float64), pt, o64, g64, lim, npairs)
+                lo2, hi2 = _driver.unit_band(out.dtype, np.float64)
+                _run(drive, w_i.astype(np.float64), w_o.astype(np.float64), pt, o64, g64, lim, lo2, hi2, bad, npairs)
                 out[...] = np.minimum(o64, lim)
                 gout[...] = np.where(o64[..., None] < lim, g64, 0.0)
             else:
-                _run(drive, w_i, w_o, pt, out, gout, ft(lim), npairs)
+                lo2, hi2 = _driver.unit_band(out.dtype, ft)
+                _run(drive, w_i, w_o, pt, out, gout, ft(lim), lo2, hi2, bad, npairs)
+            if bad.any():  # some length outside the safe band: the exact check (raises where one is not unit)
+                check_unit_flat(name, fi, fo, dtype)
         else:
+            check_unit_flat(name, fi, fo, dtype)
             o64 = np.zeros((npairs, 3))
             g64 = np.zeros((npairs, 3, n))
-            _reference(kernel, n, fi, fo, p, c, o64, g64, lim)
+            _reference(kernel, seeds, fi, fo, p, c, o64, g64, lim)
             out[...] = o64
             gout[...] = g64
     except Unsupported as e:
@@ -191,17 +229,19 @@ def eval_grad(model, wi, wo):
     f = out.reshape(shape)
     g = gout.reshape(shape + (n,))
     grads = {}
-    for pname, off, size in lay:
-        if size == 1:
-            grads[pname] = g[..., off]
-        else:
-            grads[pname] = g[..., off:off + size]
-    if "alpha" in model.params and "alpha_x" in grads and model.params["alpha"] is not None:
+    col = 0
+    for pname, _, size in lay:
+        grads[pname] = g[..., col] if size == 1 else g[..., col:col + size]
+        col += size
+    if "alpha_x" in grads and "alpha_y" in grads and model.params.get("alpha") is not None:
         grads["alpha"] = grads["alpha_x"] + grads["alpha_y"]  # alpha sets both
+    if wrt is not None:
+        asked = {wrt} if isinstance(wrt, str) else set(wrt)
+        grads = {k: v for k, v in grads.items() if k in asked}
     return f, grads
 
 
-def _run(drive, wi, wo, pt, out, gout, lim, npairs) -> None:
+def _run(drive, wi, wo, pt, out, gout, lim, lo2, hi2, bad, npairs) -> None:
     """The parallel driver, or its serial twin for a single chunk (no thread-pool launch)."""
     import sys
 
@@ -209,7 +249,7 @@ def _run(drive, wi, wo, pt, out, gout, lim, npairs) -> None:
     if npairs <= _driver.CHUNK:
         drive = getattr(sys.modules[drive.py_func.__module__], "drive_serial", drive)
     with vecmath.compiling():
-        drive(wi, wo, pt, out, gout, lim)
+        drive(wi, wo, pt, out, gout, lim, lo2, hi2, bad)
 
 
 __all__ = ["eval_grad", "layout", "GRAD_TEMPLATE"]

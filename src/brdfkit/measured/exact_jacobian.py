@@ -93,6 +93,8 @@ def exact_jacobian(packer: ParamPacker, data: Samples, metric: str) -> Callable[
         columns = _columns(packer, grads)
     except (ValueError, NotImplementedError, AttributeError):
         return None
+    # only the free parameters' derivatives: a twin seeded by fewer parameters does less work
+    wrt = sorted({nm for name, _, twin in columns for nm in (name, twin) if nm is not None})
     c = data.cos_i[:, None]
     n = len(data)
     # the residuals' weights: √w_j / √(3n), as residual_fn folds them
@@ -103,7 +105,7 @@ def exact_jacobian(packer: ParamPacker, data: Samples, metric: str) -> Callable[
 
     def jac(x: np.ndarray) -> np.ndarray:
         m = prepared.model(x)
-        f, grads = m.eval_grad(data.wi, data.wo)
+        f, grads = m.eval_grad(data.wi, data.wo, wrt=wrt)
         f = np.asarray(f, np.float64)
         J = np.empty((n, 3, k))
         for i, (name, ch, twin) in enumerate(columns):

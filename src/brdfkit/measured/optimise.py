@@ -47,11 +47,12 @@ from .samples import Samples, sample, subsample, table
 JOIN_XTOL = 1e-2
 JOIN_RTOL = 1e-3
 
-#: use the model's exact Jacobian (its ``eval_grad``, :mod:`brdfkit.measured.exact_jacobian`)
-#: where it has one; False: forward differences for every model, as before issue 31. Off by default
-#: until a fit with it is shown no worse everywhere: on (one test's 800-sample microfacet fit) the
-#: best start stopped 1.4e-6 (relative) above the finite-difference fit's loss
-EXACT_JACOBIAN = False
+#: use the model's exact Jacobian (its ``eval_grad`` for the free parameters only,
+#: :mod:`brdfkit.measured.exact_jacobian`) where it has one; False: forward differences for every
+#: model, as before issue 31. Measured (benchmarks/bench_fit.py --jacobian, docs/speed.md): the same
+#: losses to 1e-8 with 30-65 % fewer evaluations, wall times within ±15 % of the differences' (the
+#: gradient pass costs several value passes per pair)
+EXACT_JACOBIAN = True
 
 
 class _Joined(Exception):
@@ -103,7 +104,8 @@ class _Start:
 
 
 def _local(residuals, x0, packer, max_nfev, tol, known=(), const=None, groups=None, exact=None):
-    """A bounded least-squares run from ``x0``: ``(x, cost = Σ r², evaluations, joined)``.
+    """A bounded least-squares run from ``x0``: ``(x, cost = Σ r², evaluations, joined, converged)``
+    (``converged``: a tolerance stopped it, not ``max_nfev``).
 
     ``known``: ``(x, cost)`` of minima found by earlier starts; a run that enters one's
     basin (:data:`JOIN_XTOL`, :data:`JOIN_RTOL`) stops there. ``const``: the
@@ -131,8 +133,8 @@ def _local(residuals, x0, packer, max_nfev, tol, known=(), const=None, groups=No
             max_nfev=max_nfev, xtol=tol, ftol=tol, gtol=tol, diff_step=diff_step,
         )
     except _Joined as j:
-        return j.x, j.cost, fn.nfev, True
-    return res.x, float(2 * res.cost), fn.nfev, False
+        return j.x, j.cost, fn.nfev, True, True
+    return res.x, float(2 * res.cost), fn.nfev, False, res.status > 0
 
 
 def _counted(exact, fn: _Start):
@@ -274,21 +276,31 @@ def fit(
     plan = _plan_starts(packer, residuals, len(search), seed, candidates, starts, search, metric)
     nfev = plan.evaluations
     total = len(plan.chosen) + (1 if search is not data else 0)
-    best_x, best_cost = None, math.inf
+    best_x, best_cost, best_done = None, math.inf, True
     start_errors = []
     known: list[tuple[np.ndarray, float]] = []  # the minima the starts converged to
     with fit_progress(progress, f"fit {cls.name} ← {data.source}", total) as step:
         for n_done, x0 in enumerate(plan.chosen, 1):
             with _engine_threads(len(search)):
-                x, cst, used, joined = _local(residuals, x0, packer, max_nfev or 100, tol, known, plan.const,
-                                              plan.groups, plan.exact)
+                x, cst, used, joined, done = _local(residuals, x0, packer, max_nfev or 100, tol, known, plan.const,
+                                                    plan.groups, plan.exact)
             nfev += used
             start_errors.append(math.sqrt(cst))
             if not joined:
                 known.append((x, cst))
             if cst < best_cost:
-                best_cost, best_x = cst, x
+                best_cost, best_x, best_done = cst, x, done
             step(n_done)
+        if not best_done and max_nfev is None:
+            # the best start ran out of evaluations in a flat valley (gold-metallic-paint's microfacet
+            # fit stopped 2.8e-6 above the minimum, in cost, that other starts reached), and later
+            # starts that joined its basin stopped there: one more run from it, to a tolerance
+            with _engine_threads(len(search)):
+                x, cst, used, _, _ = _local(residuals, best_x, packer, 100, tol, (), plan.const, plan.groups,
+                                            plan.exact)
+            nfev += used
+            if cst < best_cost:
+                best_cost, best_x = cst, x
         if search is not data:  # polish the best start on every bin
             best_x, used = _polish(residual_fn(packer, data, T, metric), best_x, packer)
             nfev += used

@@ -127,15 +127,17 @@ class BRDF:
 
         return evaluate(self, wi, wo)
 
-    def eval_grad(self, wi, wo):
+    def eval_grad(self, wi, wo, wrt=None):
         """``(f, grads)``: ``f`` as :meth:`eval` gives it, ``grads`` a dict from each continuous parameter's
         name to ``∂f/∂param``, shape ``(..., 3)`` for a scalar and ``(..., 3, 3)`` for an RGB parameter
         (``[..., channel_out, channel_in]``). Exact (forward mode over the kernel's own source,
         :mod:`brdfkit.engine.forward`); at a ``min``/``max``/clamp or branch, the derivative of the branch
-        taken. ValueError for a model without a kernel (SPEC.md, "Gradients")."""
+        taken. ``wrt``: a parameter name or names, to compute only those derivatives (default: all; the
+        work grows with their number). ValueError for a model without a kernel, or a name that is not
+        one of its continuous parameters (SPEC.md, "Gradients")."""
         from ..engine.grad import eval_grad
 
-        return eval_grad(self, wi, wo)
+        return eval_grad(self, wi, wo, wrt)
 
     def kernel_args(self):
         """``(p, c)`` for :attr:`kernel`: float64 numeric and int64 choice arrays (see :mod:`brdfkit.engine`).
