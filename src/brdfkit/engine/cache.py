@@ -21,11 +21,16 @@ from __future__ import annotations
 
 import contextlib
 import hashlib
+import importlib.util
 import os
+import sys
+import types
 from pathlib import Path
 from typing import Callable, Iterator
 
 import numba
+
+from ..fileio import write_text
 
 _PKG = Path(__file__).resolve().parent.parent
 
@@ -131,6 +136,37 @@ def in_cache_dir() -> Iterator[None]:
         numba.config.CACHE_DIR = old
 
 
+def load_generated(folder: str, stem: str, src: str, package: str) -> types.ModuleType:
+    """The module of generated source ``src``, file ``<cache_dir>/<folder>/<stem>.py``, imported as
+    ``<package>.<stem>`` once per process: the file is written (atomically) only when its text changed,
+    and executed with numba's cache folder set to :func:`cache_dir`, so its ``cache=True`` functions'
+    machine code is reused by every process of the same package source. Used by the generated drivers
+    (:mod:`.generated`) and the forward twins (:mod:`.forward`)."""
+    modname = f"{package}.{stem}"
+    mod = sys.modules.get(modname)
+    if mod is not None:
+        return mod
+    where = cache_dir() / folder
+    where.mkdir(parents=True, exist_ok=True)
+    path = where / f"{stem}.py"
+    try:
+        current = path.read_text()
+    except OSError:
+        current = None
+    if current != src:
+        write_text(path, src)
+    spec = importlib.util.spec_from_file_location(modname, path)
+    mod = importlib.util.module_from_spec(spec)
+    sys.modules[modname] = mod  # first: a function compiled (or loaded) while it executes finds its module
+    try:
+        with in_cache_dir():
+            spec.loader.exec_module(mod)
+    except BaseException:
+        del sys.modules[modname]
+        raise
+    return mod
+
+
 JIT_OPTIONS = dict(cache=True, error_model="numpy", nogil=True)
 
 
@@ -157,4 +193,4 @@ def jit(fn: Callable | None = None, *, inline: bool = False, reassociate: bool =
         return numba.njit(**opts)(fn)
 
 
-__all__ = ["jit", "cache_dir", "prune", "source_hash", "in_cache_dir", "JIT_OPTIONS"]
+__all__ = ["jit", "cache_dir", "prune", "source_hash", "in_cache_dir", "load_generated", "JIT_OPTIONS"]

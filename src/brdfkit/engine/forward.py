@@ -31,16 +31,12 @@ cache holds their machine code (a new process does not recompile).
 from __future__ import annotations
 
 import ast
-import importlib.util
 import inspect
-import sys
 import textwrap
 import threading
-import types
 from typing import Callable
 
-from ..fileio import write_text
-from .cache import cache_dir, in_cache_dir
+from .cache import load_generated
 from .reference import _is_jitted
 
 _LOCK = threading.RLock()
@@ -774,28 +770,7 @@ def forward_function(fn: Callable, arg_patterns: tuple, seeds) -> tuple[Callable
 
 
 def _load(stem: str, src: str, name: str) -> Callable:
-    folder = cache_dir() / "forward"
-    folder.mkdir(parents=True, exist_ok=True)
-    path = folder / f"{stem}.py"
-    try:
-        current = path.read_text()
-    except OSError:
-        current = None
-    if current != src:
-        write_text(path, src)
-    modname = f"brdfkit._engine_forward.{stem}"
-    mod = sys.modules.get(modname)
-    if mod is None:
-        spec = importlib.util.spec_from_file_location(modname, path)
-        mod = importlib.util.module_from_spec(spec)
-        sys.modules[modname] = mod
-        try:
-            with in_cache_dir():
-                spec.loader.exec_module(mod)
-        except BaseException:
-            del sys.modules[modname]
-            raise
-    return getattr(mod, name)
+    return getattr(load_generated("forward", stem, src, "brdfkit._engine_forward"), name)
 
 
 def forward_kernel(kernel: Callable, seeds) -> tuple[Callable, tuple]:

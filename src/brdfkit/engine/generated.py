@@ -1,9 +1,9 @@
 """The generated driver modules: written into the cache folder, imported from there, memoised per key.
 
 A driver's source is one of :mod:`.templates`, formatted for a kernel (and a choice combination, a
-layout, a span, a scalar term). :func:`_load` writes it to ``<cache_dir>/drivers/<stem>.py`` (only when
-the text changed: :func:`brdfkit.fileio.write_text`, atomically) and imports it with numba's cache folder
-set to :func:`brdfkit.engine.cache.cache_dir`, so a new process of the same package source loads every
+layout, a span, a scalar term). :func:`_load` writes it to ``<cache_dir>/drivers/<stem>.py`` and imports it
+(:func:`brdfkit.engine.cache.load_generated`: written only when the text changed, atomically, executed
+with numba's cache folder set to :func:`brdfkit.engine.cache.cache_dir`), so a new process of the same package source loads every
 compiled driver from disk. The folder's name holds a hash of the package source, the file's name the
 kernel's module and name, its precision and whether it calls libmvec (:func:`_stem`), so a cached driver
 is only ever reused for the source and vector-math setting it was compiled from.
@@ -15,16 +15,13 @@ work estimates of :mod:`.cost`.
 
 from __future__ import annotations
 
-import importlib.util
 import re
-import sys
 import threading
 from collections import Counter
 from typing import Callable
 
-from ..fileio import write_text
 from . import vecmath
-from .cache import cache_dir, in_cache_dir
+from .cache import load_generated
 from .templates import (CHUNK, ELEMENTWISE_TEMPLATE, FASTMATH, FTYPE, KERNEL_LINE, SOA_TEMPLATE, SPAN_TEMPLATE,
                         SPECIAL_TEMPLATE, TEMPLATE)
 
@@ -44,25 +41,7 @@ def _load(key: tuple, stem: str, src: str) -> Callable:
         d = _DRIVERS.get(key)
         if d is not None:
             return d
-        folder = cache_dir() / "drivers"
-        folder.mkdir(parents=True, exist_ok=True)
-        path = folder / f"{stem}.py"
-        try:
-            current = path.read_text()
-        except OSError:
-            current = None
-        if current != src:
-            write_text(path, src)
-        modname = f"brdfkit._engine_drivers.{stem}"
-        spec = importlib.util.spec_from_file_location(modname, path)
-        mod = importlib.util.module_from_spec(spec)
-        sys.modules[modname] = mod  # first: a driver compiled (or loaded) while it executes finds its module
-        try:
-            with in_cache_dir():
-                spec.loader.exec_module(mod)
-        except BaseException:
-            del sys.modules[modname]
-            raise
+        mod = load_generated("drivers", stem, src, "brdfkit._engine_drivers")
         if hasattr(mod, "drive_serial"):
             _SERIAL[key] = mod.drive_serial
         _DRIVERS[key] = mod.drive
