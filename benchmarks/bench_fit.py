@@ -6,6 +6,8 @@
     python benchmarks/bench_fit.py --batch --save new.json --compare old.json   # and its losses vs another run's
     python benchmarks/bench_fit.py --starts-needed # how many starts reach the dense multi-start minimum
     python benchmarks/bench_fit.py --per-call      # one residual evaluation: prepared vs model built per call
+    python benchmarks/bench_fit.py --jacobian      # six materials × five models: exact Jacobian vs differences
+    BRDFKIT_FIT_JACOBIAN=differences python benchmarks/bench_fit.py --batch   # any mode, without eval_grad
 
 Prints wall times (default settings of ``brdfkit fit``: 3000 samples, 4 starts, metric
 ngan), errors and evaluations used, and for a batch the CPU seconds its worker processes
@@ -85,6 +87,7 @@ def main() -> int:
     ap.add_argument("--compare", help="with --batch: compare its losses with those saved in this JSON file")
     ap.add_argument("--per-call", action="store_true", help="time one residual evaluation, prepared and not")
     ap.add_argument("--skip-single", action="store_true", help="skip the single and table-scale fits")
+    ap.add_argument("--jacobian", action="store_true", help="exact Jacobian (eval_grad) against forward differences")
     args = ap.parse_args()
 
     print(f"cpus available: {len(os.sched_getaffinity(0))}, load average: {os.getloadavg()[0]:.2f}, "
@@ -119,7 +122,49 @@ def main() -> int:
         starts_needed(args.n_materials)
     if args.per_call:
         per_call(args.material)
+    if args.jacobian:
+        jacobian_modes()
     return 0
+
+
+JACOBIAN_MATERIALS = ("merl/gold-metallic-paint", "merl/blue-acrylic", "merl/chrome", "merl/neoprene-rubber",
+                      "merl/cherry-235", "merl/dark-blue-paint")
+
+
+def jacobian_modes(repeat: int = 2) -> None:
+    """Warm fits with the exact Jacobian and with forward differences, alternating, best wall time of
+    ``repeat`` each: wall s, loss, evaluations (a gradient evaluation counts one)."""
+    from brdfkit.measured import optimise
+
+    datas = {m: F.sample(m, n=3000) for m in JACOBIAN_MATERIALS}
+    for exact in (False, True):  # warm-up: drivers and gradient twins loaded or compiled
+        optimise.EXACT_JACOBIAN = exact
+        for name, fixed in MODELS:
+            F.fit(name, JACOBIAN_MATERIALS[0], fixed=fixed, data=datas[JACOBIAN_MATERIALS[0]])
+    print(f"{'material':<28}{'model':<20}{'differences: s':>15}{'evals':>7}{'exact: s':>10}{'evals':>7}"
+          f"{'loss (exact)':>14}{'rel. change':>13}")
+    ratios, changes = [], []
+    try:
+        for mat in JACOBIAN_MATERIALS:
+            for name, fixed in MODELS:
+                best = {}
+                for _ in range(repeat):
+                    for exact in (False, True):
+                        optimise.EXACT_JACOBIAN = exact
+                        w0 = time.perf_counter()
+                        r = F.fit(name, mat, fixed=fixed, data=datas[mat])
+                        w = time.perf_counter() - w0
+                        if exact not in best or w < best[exact][0]:
+                            best[exact] = (w, r.error, r.nfev)
+                d, e = best[False], best[True]
+                ratios.append(e[0] / d[0])
+                changes.append((e[1] - d[1]) / d[1])
+                print(f"{mat:<28}{name:<20}{d[0]:>15.3f}{d[2]:>7}{e[0]:>10.3f}{e[2]:>7}{e[1]:>14.6g}{changes[-1]:>+13.2e}")
+    finally:
+        optimise.EXACT_JACOBIAN = True
+    print(f"wall time exact / differences: median {np.median(ratios):.2f}, range {min(ratios):.2f}-{max(ratios):.2f}; "
+          f"loss change: median {np.median(changes):+.1e}, max {max(changes):+.1e}, min {min(changes):+.1e}; "
+          f"load average {os.getloadavg()[0]:.2f}")
 
 
 def single(material: str) -> None:

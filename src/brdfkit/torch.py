@@ -7,8 +7,8 @@ tensor, an RGB one as a shape ``(3,)`` tensor (or a 0-d one: grey). Choices, boo
 a tensor there is a ``ValueError``. ``wi`` and ``wo`` are tensors of shape ``(..., 3)``; the result is
 ``f`` of shape ``broadcast(wi, wo)``, as ``m.eval`` gives it (the forward pass is ``m.eval``), float32 for float32 directions.
 
-The backward pass uses the model's exact derivatives, ``m.eval_grad(wi, wo)``, computed in the forward
-pass when a parameter tensor requires grad. Gradients flow to the parameter tensors only: ``eval_grad``
+The backward pass uses the model's exact derivatives, ``m.eval_grad(wi, wo, wrt=...)`` for the parameter
+tensors that require grad (only those are computed), in the forward pass. Gradients flow to the parameter tensors only: ``eval_grad``
 gives no derivative with respect to the directions, so ``wi`` and ``wo`` get ``None`` (a direction tensor
 that requires grad is accepted; its ``.grad`` stays unset). Not twice differentiable. A model without
 derivatives (a measured material, ``microfacet`` with ``multiscatter=True``) raises ``ValueError`` as
@@ -48,20 +48,12 @@ def _function(torch):
             want = list(ctx.needs_input_grad[5:])
             f = model.eval(a, b)  # the values are eval's (eval_grad's float32 f may differ in the last bits)
             if any(want):
+                wrt = [n for n, w in zip(names, want) if w]  # only the derivatives the graph needs
                 try:
-                    _, grads = model.eval_grad(a, b)
+                    _, grads = model.eval_grad(a, b, wrt=wrt)
                 except ValueError as e:
                     raise ValueError(f"brdfkit.torch.eval: {e}") from None
-                g = []
-                for n, w in zip(names, want):
-                    if not w:
-                        g.append(None)
-                    elif n not in grads:
-                        raise ValueError(f"brdfkit.torch.eval: {model.name}: no derivative with respect to "
-                                         f"'{n}' (differentiable: {', '.join(grads)})")
-                    else:
-                        g.append(grads[n])
-                ctx.grads = g
+                ctx.grads = [grads[n] if w else None for n, w in zip(names, want)]
             else:
                 ctx.grads = [None] * len(values)
             ctx.sizes = sizes

@@ -22,6 +22,7 @@ of them (:func:`_polish`).
 from __future__ import annotations
 
 import math
+import os
 import time
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -51,8 +52,9 @@ JOIN_RTOL = 1e-3
 #: :mod:`brdfkit.measured.exact_jacobian`) where it has one; False: forward differences for every
 #: model, as before issue 31. Measured (benchmarks/bench_fit.py --jacobian, docs/speed.md): the same
 #: losses to 1e-8 with 30-65 % fewer evaluations, wall times within ±15 % of the differences' (the
-#: gradient pass costs several value passes per pair)
-EXACT_JACOBIAN = True
+#: gradient pass costs several value passes per pair). The environment variable
+#: ``BRDFKIT_FIT_JACOBIAN=differences`` sets it False in every process (a batch's workers included).
+EXACT_JACOBIAN = os.environ.get("BRDFKIT_FIT_JACOBIAN", "exact") != "differences"
 
 
 class _Joined(Exception):
