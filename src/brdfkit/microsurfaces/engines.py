@@ -8,7 +8,7 @@ Both engines answer the same question for a batch of rays in a tile's base frame
 * ``"mitsuba-scalar"`` — Mitsuba 3's ``scalar_rgb`` variant, one ray per call from Python: the
   fallback where no LLVM is available, and the baseline of ``benchmarks/bench_microsurface.py``.
 * ``"embree"`` — Intel Embree through the maintained ``embreex`` binding (``pip install
-  embreex``; the binding trimesh uses), one ``rtcIntersect`` batch per call.
+  'brdfkit[measure-embree]'``; the binding trimesh uses), one ``rtcIntersect`` batch per call.
 
 Mitsuba is an optional dependency (``pip install brdfkit[measure]``). Mitsuba has one active
 variant per process; each call switches to its variant and back (other parts of brdfkit use
@@ -55,7 +55,7 @@ def _embreex():
     try:
         from embreex import mesh_construction, rtcore_scene
     except ImportError:
-        raise ValueError("the 'embree' microsurface engine needs the embreex binding: pip install embreex") from None
+        raise ValueError("the 'embree' microsurface engine needs the embreex binding: pip install 'brdfkit[measure-embree]'") from None
     return mesh_construction, rtcore_scene
 
 
