@@ -42,7 +42,8 @@ max_bounces    int     64              reflections after which a ray counts as l
 
 from __future__ import annotations
 
-from typing import Any, NamedTuple
+from collections import OrderedDict
+from typing import Any, Callable, NamedTuple
 
 import numpy as np
 
@@ -55,8 +56,22 @@ from .tracer import EPS_REL, Paths, propagate, trace
 KINDS = ("v-groove", "beckmann", "ggx")
 CORR_CELLS = 6.0  # correlation length of the random tiles, in grid cells
 
-_TILES: dict[tuple, Tile] = {}
-_ENGINES: dict[tuple, MitsubaEngine] = {}
+#: tiles and engines kept between calls, each cache its ``_KEEP`` most recently used (a 512² tile and
+#: its engine's scene are tens of MB); keyed by the tile's parameters, so an equal tile finds its engine
+_KEEP = 4
+_TILES: OrderedDict[tuple, Tile] = OrderedDict()
+_ENGINES: OrderedDict[tuple, MitsubaEngine] = OrderedDict()
+
+
+def _cached(cache: OrderedDict, key: tuple, make: Callable[[], Any]) -> Any:
+    """``cache[key]``, made by ``make()`` when missing; the least recently used beyond ``_KEEP`` are dropped."""
+    if key in cache:
+        cache.move_to_end(key)
+        return cache[key]
+    value = cache[key] = make()
+    while len(cache) > _KEEP:
+        cache.popitem(last=False)
+    return value
 
 
 class Estimate(NamedTuple):
@@ -128,20 +143,19 @@ class Microsurface:
 
     # -- the surface -------------------------------------------------------------------
     @property
+    def _tile_key(self) -> tuple:
+        """The parameters that determine the tile (the same key, the same tile)."""
+        return ("v-groove", self.angle) if self.kind == "v-groove" else ("gauss", self.resolution, self.seed)
+
+    @property
     def tile(self) -> Tile:
-        key = ("v-groove", self.angle) if self.kind == "v-groove" else ("gauss", self.resolution, self.seed)
-        if key not in _TILES:
-            _TILES[key] = (_surf.v_groove(self.angle) if self.kind == "v-groove"
-                           else _surf.gaussian_field(self.resolution, CORR_CELLS, self.seed))
-        return _TILES[key]
+        if self.kind == "v-groove":
+            return _cached(_TILES, self._tile_key, lambda: _surf.v_groove(self.angle))
+        return _cached(_TILES, self._tile_key, lambda: _surf.gaussian_field(self.resolution, CORR_CELLS, self.seed))
 
     @property
     def engine(self) -> MitsubaEngine:
-        tile = self.tile
-        key = (id(tile), self.engine_name)
-        if key not in _ENGINES:
-            _ENGINES[key] = make_engine(tile, self.engine_name)
-        return _ENGINES[key]
+        return _cached(_ENGINES, self._tile_key + (self.engine_name,), lambda: make_engine(self.tile, self.engine_name))
 
     def scales(self, n: int) -> _surf.Scales:
         """Base → world maps for ``n`` rays (a fresh mixture weight per ray for GGX)."""
