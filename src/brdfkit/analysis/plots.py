@@ -464,8 +464,11 @@ def plot(kind: str, models: Sequence[Any], **options: Any):
     return funcs[kind](models, **options)
 
 
-def save_figure(fig, path: str | Path, dpi: int = 150) -> Path:
-    """Write ``fig`` as PNG, SVG or PDF (by extension)."""
+def save_figure(fig, path: str | Path, dpi: float | str = 150, bbox_inches: str | None = None) -> Path:
+    """Write ``fig`` as PNG, SVG or PDF (by extension), atomically (a killed write leaves the previous file).
+
+    ``dpi`` ``"figure"`` keeps the figure's own; ``bbox_inches="tight"`` crops the margins to the content.
+    """
     from matplotlib.backends.backend_agg import FigureCanvasAgg
 
     p = Path(path)
@@ -478,7 +481,7 @@ def save_figure(fig, path: str | Path, dpi: int = 150) -> Path:
         raise OSError(f"plot: output folder does not exist: {str(p.parent)!r}")
     FigureCanvasAgg(fig)
     with atomic_path(p) as tmp:  # a killed write leaves the previous file whole
-        fig.savefig(tmp, dpi=dpi, format=ext[1:])
+        fig.savefig(tmp, dpi=dpi, format=ext[1:], bbox_inches=bbox_inches)
     return p
 
 

@@ -24,25 +24,13 @@ Estimators (all with their standard errors)
   irradiance, so no cos θi). The cone
   is a bias of second order in ``radius`` (smaller cones, more noise).
 
-=============  ======  ==============  ==============================================================
-parameter      kind    default         meaning
-=============  ======  ==============  ==============================================================
-kind           choice  —               ``v-groove`` | ``beckmann`` | ``ggx``
-alpha          scalar  0.2             roughness (Beckmann RMS slope / GGX width), sets alpha_x = alpha_y
-alpha_x/_y     scalar  0.2             anisotropic roughness along the tangent / bitangent
-angle          scalar  30              V-groove facet angle from the macro normal, degrees (0, 90)
-fresnel        choice  white           ``white`` (F = 1) or a ``microfacet`` Fresnel: conductor |
-                                       dielectric | schlick, with ``eta``, ``k``, ``f0`` as there
-resolution     int     512             grid cells per side of the random tile
-seed           int     0               the random tile and the rays
-engine         choice  mitsuba-llvm    ``mitsuba-llvm`` | ``mitsuba-scalar`` | ``embree`` (:mod:`.engines`)
-max_bounces    int     64              reflections after which a ray counts as lost
-=============  ======  ==============  ==============================================================
+The parameters of :func:`microsurface` are tabled in :class:`Microsurface`'s text.
 """
 
 from __future__ import annotations
 
-from typing import Any, NamedTuple
+from collections import OrderedDict
+from typing import Any, Callable, NamedTuple
 
 import numpy as np
 
@@ -55,8 +43,22 @@ from .tracer import EPS_REL, Paths, propagate, trace
 KINDS = ("v-groove", "beckmann", "ggx")
 CORR_CELLS = 6.0  # correlation length of the random tiles, in grid cells
 
-_TILES: dict[tuple, Tile] = {}
-_ENGINES: dict[tuple, MitsubaEngine] = {}
+#: tiles and engines kept between calls, each cache its ``_KEEP`` most recently used (a 512² tile and
+#: its engine's scene are tens of MB); keyed by the tile's parameters, so an equal tile finds its engine
+_KEEP = 4
+_TILES: OrderedDict[tuple, Tile] = OrderedDict()
+_ENGINES: OrderedDict[tuple, MitsubaEngine] = OrderedDict()
+
+
+def _cached(cache: OrderedDict, key: tuple, make: Callable[[], Any]) -> Any:
+    """``cache[key]``, made by ``make()`` when missing; the least recently used beyond ``_KEEP`` are dropped."""
+    if key in cache:
+        cache.move_to_end(key)
+        return cache[key]
+    value = cache[key] = make()
+    while len(cache) > _KEEP:
+        cache.popitem(last=False)
+    return value
 
 
 class Estimate(NamedTuple):
@@ -98,7 +100,38 @@ def _int_param(name: str, value: Any, lo: int) -> int:
 
 
 class Microsurface:
-    """An explicit microsurface and its simulated masking, albedo and BRDF (see the module text)."""
+    """An explicit microsurface and its simulated masking, albedo and BRDF (see the module text).
+
+    ``microsurface(kind, **params)`` makes one; every parameter but ``kind`` is a keyword with a default:
+
+    ===========  ======  ============  =========================  =======  ======================================
+    parameter    kind    default       range                      unit     meaning
+    ===========  ======  ============  =========================  =======  ======================================
+    kind         choice  (required)    v-groove | beckmann | ggx  —        the construction: V-grooves, or a
+                                                                           Gaussian heightfield (Beckmann or GGX)
+    alpha        scalar  0.2           [0.001, 1]                 —        roughness (Beckmann RMS slope / GGX
+                                                                           width); sets alpha_x = alpha_y; not
+                                                                           for v-groove
+    alpha_x      scalar  0.2           [0.001, 1]                 —        roughness along the tangent +x
+    alpha_y      scalar  0.2           [0.001, 1]                 —        roughness along the bitangent +y
+    angle        scalar  30            (0, 90)                    degrees  V-groove facet angle from the macro
+                                                                           normal (v-groove only)
+    fresnel      choice  white         white | conductor |        —        the facets' reflectance: ``white``
+                                       dielectric | schlick                (F = 1, also ``none``) or microfacet's
+                                                                           Fresnel with ``eta``, ``k``, ``f0``
+    eta          rgb     gold          [0.01, 10]                 —        real part of the facets' index
+                                                                           (conductor, dielectric)
+    k            rgb     gold          [0, 20]                    —        imaginary part (conductor only)
+    f0           rgb     gold's        [0, 1]                     —        normal-incidence reflectance (schlick)
+    resolution   int     512           16 or more                 cells    grid cells per side of the random
+                                                                           tile (beckmann, ggx)
+    seed         int     0             0 or more                  —        the random tile and the rays
+    engine       choice  mitsuba-llvm  mitsuba-llvm |             —        what intersects the rays
+                                       mitsuba-scalar | embree             (:mod:`.engines`)
+    max_bounces  int     64            1 or more                  —        reflections after which a ray counts
+                                                                           as lost
+    ===========  ======  ============  =========================  =======  ======================================
+    """
 
     def __init__(self, kind: str, **params: Any) -> None:
         if kind not in KINDS:
@@ -128,20 +161,19 @@ class Microsurface:
 
     # -- the surface -------------------------------------------------------------------
     @property
+    def _tile_key(self) -> tuple:
+        """The parameters that determine the tile (the same key, the same tile)."""
+        return ("v-groove", self.angle) if self.kind == "v-groove" else ("gauss", self.resolution, self.seed)
+
+    @property
     def tile(self) -> Tile:
-        key = ("v-groove", self.angle) if self.kind == "v-groove" else ("gauss", self.resolution, self.seed)
-        if key not in _TILES:
-            _TILES[key] = (_surf.v_groove(self.angle) if self.kind == "v-groove"
-                           else _surf.gaussian_field(self.resolution, CORR_CELLS, self.seed))
-        return _TILES[key]
+        if self.kind == "v-groove":
+            return _cached(_TILES, self._tile_key, lambda: _surf.v_groove(self.angle))
+        return _cached(_TILES, self._tile_key, lambda: _surf.gaussian_field(self.resolution, CORR_CELLS, self.seed))
 
     @property
     def engine(self) -> MitsubaEngine:
-        tile = self.tile
-        key = (id(tile), self.engine_name)
-        if key not in _ENGINES:
-            _ENGINES[key] = make_engine(tile, self.engine_name)
-        return _ENGINES[key]
+        return _cached(_ENGINES, self._tile_key + (self.engine_name,), lambda: make_engine(self.tile, self.engine_name))
 
     def scales(self, n: int) -> _surf.Scales:
         """Base → world maps for ``n`` rays (a fresh mixture weight per ray for GGX)."""
@@ -290,7 +322,8 @@ def cone_cosine_integral(o: np.ndarray, radius: float, n: int = 64) -> float:
 
 
 def microsurface(kind: str, **params: Any) -> Microsurface:
-    """An explicit microsurface ``kind`` (``"v-groove"``, ``"beckmann"``, ``"ggx"``); see :class:`Microsurface`."""
+    """An explicit microsurface ``kind`` (``"v-groove"``, ``"beckmann"``, ``"ggx"``); :class:`Microsurface`'s text
+    tables the parameters (meaning, range, unit, default)."""
     return Microsurface(kind, **params)
 
 

@@ -20,7 +20,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..fileio import atomic_path, check_output_path
+from ..analysis.plots import save_figure
+from ..fileio import check_output_path
 from . import microsurface
 from .engines import make_engine
 from .surfaces import Scales, grid_tile
@@ -97,8 +98,7 @@ def cross_section(path, alpha: float = 0.9, theta_deg: float = 60.0, rays: int =
                  "traced with Mitsuba 3", fontsize=9)
     ax.legend(loc="upper right", fontsize=8, frameon=False)
     fig.tight_layout()
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, bbox_inches="tight")  # the equal-aspect cut leaves wide margins otherwise
+    save_figure(fig, path, dpi="figure", bbox_inches="tight")  # the equal-aspect cut leaves wide margins otherwise
     plt.close(fig)
     return path
 
@@ -140,8 +140,7 @@ def masking_curves(path, samples: int = 20000) -> Path:
         ax.grid(alpha=0.3)
         ax.legend(fontsize=7, loc="lower left", frameon=False)
     fig.tight_layout()
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp)
+    save_figure(fig, path, dpi="figure")
     plt.close(fig)
     return path
 
@@ -179,8 +178,7 @@ def albedo_split(path, samples: int = 40000) -> Path:
         ax.grid(alpha=0.3)
         ax.legend(fontsize=6.5, loc="upper left", bbox_to_anchor=(1.0, 1.0), frameon=False)
     fig.tight_layout()
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp)
+    save_figure(fig, path, dpi="figure")
     plt.close(fig)
     return path
 

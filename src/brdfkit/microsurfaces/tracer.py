@@ -19,6 +19,7 @@ from typing import Callable
 
 import numpy as np
 
+from ..geometry import dot, reflect
 from .engines import MitsubaEngine
 from .surfaces import Scales, Tile
 
@@ -90,11 +91,6 @@ class Paths:
     points: list | None = None  # base-frame vertices of each path, when recorded
 
 
-def reflect(w: np.ndarray, n: np.ndarray) -> np.ndarray:
-    """Mirror direction of ``w`` (travel direction) about unit normals ``n``."""
-    return w - 2.0 * np.sum(w * n, axis=-1, keepdims=True) * n
-
-
 def trace(engine: MitsubaEngine, tile: Tile, scales: Scales, o: np.ndarray, w_world: np.ndarray,
           fresnel: Callable[[np.ndarray], np.ndarray], max_bounces: int, record: bool = False) -> Paths:
     """Trace rays from base-frame points ``o`` travelling along world directions ``w_world`` until they leave.
@@ -126,11 +122,11 @@ def trace(engine: MitsubaEngine, tile: Tile, scales: Scales, o: np.ndarray, w_wo
             todo = idx
             break
         nb = tile.normals[face[hit]]
-        from_below = np.sum(d[hit] * nb, axis=-1) > 0
+        from_below = dot(d[hit], nb) > 0
         nw = sc.take(hit).world_normal(nb)
         wi = w[idx]
-        cos = np.clip(-np.sum(wi * nw, axis=-1), 0.0, 1.0)
-        w[idx] = reflect(wi, nw)
+        cos = np.clip(-dot(wi, nw), 0.0, 1.0)
+        w[idx] = reflect(-wi, nw)  # geometry's reflect takes the direction toward the light, not of travel
         weight[idx] *= fresnel(cos)
         bounces[idx] += 1
         p[idx] = ph[hit] + eps * nb

@@ -66,12 +66,20 @@ class Panel:
     look: Any = None  # a scene.Look replacing the material's default look (exposure then ignored)
 
 
+def _available_everywhere() -> str | None:
+    """The default ``unavailable()``: no reason, the figure can be made anywhere."""
+    return None
+
+
 @dataclass
 class Figure:
+    """A grid of rendered panels; ``unavailable()`` gives the reason it cannot be made here, or None."""
+
     name: str
     title: str
     columns: int
     panels: Callable[[], list[Panel]] = field(repr=False)
+    unavailable: Callable[[], str | None] = field(repr=False, default=_available_everywhere)
 
 
 FRONT = {"eye": [0.0, 0.0, 3.6], "target": [0.0, 0.0, 0.0], "up": [0.0, 1.0, 0.0], "fov_deg": 36.0}
@@ -277,7 +285,7 @@ class PlotFigure:
     name: str
     title: str
     files: Callable[[], dict[str, Callable[[Path], Path]]] = field(repr=False)
-    unavailable: Callable[[], str | None] = field(repr=False, default=lambda: None)
+    unavailable: Callable[[], str | None] = field(repr=False, default=_available_everywhere)
 
 
 def _microsurface_plots() -> dict[str, Callable[[Path], Path]]:
@@ -320,13 +328,13 @@ def gallery_names(only: Sequence[str] | None, notify: Callable[[str], None] = la
         for n in only:
             if n not in FIGURES:
                 raise ValueError(f"unknown figure {n!r}; valid figures: {', '.join(FIGURES)}")
-            why = getattr(FIGURES[n], "unavailable", lambda: None)()
+            why = FIGURES[n].unavailable()
             if why:
                 raise ValueError(f"figure {n!r} cannot be made here: {why}")
         return list(only)
     names = []
     for n, f in FIGURES.items():
-        why = getattr(f, "unavailable", lambda: None)()
+        why = f.unavailable()
         if why:
             notify(f"skipped figure {n!r}: {why}")
         else:
