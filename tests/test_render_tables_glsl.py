@@ -120,6 +120,34 @@ def test_utia_texture_layout_and_pack_round_trip(files):
         tables.table_set(bk.model("lambert"))
 
 
+def test_table_set_is_built_once_and_read_only(files):
+    m = bk.model(str(files["aniso"]))
+    ts = tables.table_set(m)
+    assert tables.table_set(m) is ts
+    assert tables.table_set(bk.model(str(files["aniso"]))) is ts  # the same file: the same (digest) key
+    assert all(not t.data.flags.writeable for t in ts.textures)
+    with pytest.raises(ValueError, match="read-only"):
+        ts.textures[0].data[0, 0, 0, 0] = 1.0
+    fresh = tables.rgl_tables(m)  # the builder itself: a new, writable set equal to the held one
+    assert all(t.data.flags.writeable and np.array_equal(t.data, h.data) for t, h in zip(fresh.textures, ts.textures))
+    tables.table_set(bk.model(str(files["iso"])))
+    tables.table_set(bk.model(str(files["utia"])))
+    assert tables.table_set(m) is not ts  # two other sets asked for since: this one was dropped and rebuilt
+
+
+def test_held_keeps_the_last_ones_by_key():
+    held, built = tables.Held(2), []
+
+    def build(v):
+        return lambda: built.append(v) or v
+
+    assert held.get("a", build(1)) == 1 and held.get("b", build(2)) == 2
+    assert held.get("a", build(10)) == 1 and built == [1, 2]  # held: not built again
+    held.get("c", build(3))  # "b" is the least recently used
+    assert len(held) == 2 and held.get("b", build(20)) == 20 and held.get("a", build(30)) == 30
+    assert built == [1, 2, 3, 20, 30]
+
+
 @pytest.mark.parametrize("which", ["aniso", "utia"])
 def test_render_glsl_equals_numpy(files, which):
     from brdfkit.render import make_scene, render_linear
