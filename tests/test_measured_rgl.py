@@ -25,6 +25,7 @@ from brdfkit.measured import cie
 from brdfkit.measured.rgl import RGLBRDF, load_rgl, spectral_to_rgb_matrix
 from brdfkit.measured.tensor_file import read_tensor_file, tensor_file_bytes, write_tensor_file
 from _mitsuba_helpers import mitsuba_f_r
+from _numeric_helpers import hemisphere_pairs, load_or_one_line_error
 
 RTOL, ATOL = 1e-4, 1e-7
 
@@ -52,18 +53,6 @@ def rgl_fields(n_phi=1, n_theta=4, res=6, reduction=1, seed=0, jacobian=1, spect
         f["wavelengths"] = np.asarray(spectral, np.float32)
         f["spectra"] = rng.uniform(0.1, 1.0, (n_phi, n_theta, len(spectral), res, res)).astype(np.float32)
     return f
-
-
-def random_pairs(n, seed, zmin=0.02):
-    rng = np.random.default_rng(seed)
-
-    def dirs():
-        z = rng.uniform(zmin, 1.0, n)
-        p = rng.uniform(-np.pi, np.pi, n)
-        s = np.sqrt(1 - z * z)
-        return np.stack([s * np.cos(p), s * np.sin(p), z], axis=1)
-
-    return dirs(), dirs()
 
 
 def write(tmp_path, name, **kw) -> str:
@@ -100,7 +89,7 @@ def mitsuba_cases(mi, tmp_path_factory):
     for i, (name, kw) in enumerate(CASES.items()):  # in this order (see CASES)
         path = str(d / f"case{i}.bsdf")
         write_tensor_file(path, rgl_fields(**kw))
-        wi, wo = random_pairs(2000, 100 + i)
+        wi, wo = hemisphere_pairs(2000, 100 + i)
         out[name] = (path, wi, wo, mitsuba_eval(mi, path, wi, wo))
     return out
 
@@ -155,7 +144,7 @@ def test_cie_tables_are_mitsubas(mi):
 # ----------------------------------------------------------------- the model contract
 def test_contract_float32_horizon_finite(tmp_path):
     m = load_rgl(write(tmp_path, "a.bsdf", n_phi=3, reduction=4))
-    wi, wo = random_pairs(500, 1, zmin=-0.3)
+    wi, wo = hemisphere_pairs(500, 1, zmin=-0.3)
     f64 = m.eval(wi, wo)
     assert f64.dtype == np.float64 and f64.shape == (500, 3)
     below = (wi[:, 2] <= 0) | (wo[:, 2] <= 0)
@@ -182,7 +171,7 @@ def test_large_batches_equal_small_ones(tmp_path):
 
     m = load_rgl(write(tmp_path, "big.bsdf", n_phi=3, reduction=4))
     n = 2 * rgl._CHUNK + 123
-    wi, wo = random_pairs(n, 9)
+    wi, wo = hemisphere_pairs(n, 9)
     f = m.eval(wi, wo)
     for a in (0, rgl._CHUNK - 5, n - 40):
         np.testing.assert_array_equal(f[a:a + 40], m.eval(wi[a:a + 40], wo[a:a + 40]))
@@ -193,14 +182,14 @@ def test_negative_table_values_are_clamped(tmp_path):
     f["rgb"][..., 0, :, :] = -1.0
     p = str(tmp_path / "neg.bsdf")
     write_tensor_file(p, f)
-    v = load_rgl(p).eval(*random_pairs(200, 2))
+    v = load_rgl(p).eval(*hemisphere_pairs(200, 2))
     assert (v[:, 0] == 0).all() and (v[:, 1:] > 0).all()
 
 
 def test_isotropic_file_depends_on_azimuth_difference_only(tmp_path):
     m = load_rgl(write(tmp_path, "iso.bsdf"))
     assert m.isotropic and not m.spectral and m.jacobian and m.description == "synthetic test material"
-    wi, wo = random_pairs(300, 3)
+    wi, wo = hemisphere_pairs(300, 3)
     a = np.random.default_rng(0).uniform(0, 2 * np.pi, (300, 1))
     rot = lambda d: np.stack([d[:, 0] * np.cos(a[:, 0]) - d[:, 1] * np.sin(a[:, 0]),  # noqa: E731
                               d[:, 0] * np.sin(a[:, 0]) + d[:, 1] * np.cos(a[:, 0]), d[:, 2]], axis=1)
@@ -212,7 +201,7 @@ def test_anisotropic_symmetry_reduction(tmp_path, reduction, n_phi):
     """Reduction 2: a rotation by π is the same configuration; 4: so are the mirrors in x and y."""
     m = load_rgl(write(tmp_path, "an.bsdf", n_phi=n_phi, reduction=reduction, seed=11))
     assert not m.isotropic and m.reduction == reduction
-    wi, wo = random_pairs(300, 4)
+    wi, wo = hemisphere_pairs(300, 4)
     f = m.eval(wi, wo)
     turn = np.array([-1.0, -1.0, 1.0])
     np.testing.assert_allclose(m.eval(wi * turn, wo * turn), f, rtol=1e-9)
@@ -250,7 +239,7 @@ def test_spectral_file_is_its_rgb_file(tmp_path):
     rgb["rgb"] = np.einsum("cl,ptlhw->ptchw", spectral_to_rgb_matrix(wl), f["spectra"]).astype(np.float32)
     pr = str(tmp_path / "rgb.bsdf")
     write_tensor_file(pr, rgb)
-    wi, wo = random_pairs(500, 5)
+    wi, wo = hemisphere_pairs(500, 5)
     m = load_rgl(ps)
     assert m.spectral
     np.testing.assert_allclose(np.maximum(load_rgl(pr).eval(wi, wo), 0), m.eval(wi, wo), rtol=1e-5, atol=1e-7)
@@ -368,21 +357,12 @@ def test_fuzz_mutated_files_raise_value_error_only(tmp_path_factory, edits, head
     p = str(tmp_path_factory.mktemp("fuzz") / "f.bsdf")
     with open(p, "wb") as fh:
         fh.write(bytes(raw))
-    tracemalloc.start()
-    try:
-        try:
-            m = load_rgl(p)
-        except ValueError as e:
-            assert "\n" not in str(e)
-            m = None
-        peak = tracemalloc.get_traced_memory()[1]
-    finally:
-        tracemalloc.stop()
+    m, peak = load_or_one_line_error(load_rgl, p)
     assert peak < 200 * len(_GOOD) + (4 << 20)
     if m is not None:  # a mutation that still makes a valid file: evaluation keeps the contract
-        v = m.eval(*random_pairs(50, 0))
+        v = m.eval(*hemisphere_pairs(50, 0))
         assert np.isfinite(v).all() and (v >= 0).all()
-        v32 = m.eval(*(d.astype(np.float32) for d in random_pairs(50, 0)))
+        v32 = m.eval(*(d.astype(np.float32) for d in hemisphere_pairs(50, 0)))
         assert np.isfinite(v32).all() and (v32 >= 0).all()
 
 
@@ -393,7 +373,7 @@ def test_sources_model_and_load_measured(tmp_path):
     m = bk.model(p)
     assert isinstance(m, RGLBRDF) and m.label == "mat"
     m2 = bk.load_measured(p)
-    wi, wo = random_pairs(50, 6)
+    wi, wo = hemisphere_pairs(50, 6)
     np.testing.assert_array_equal(m.eval(wi, wo), m2.eval(wi, wo))
     with pytest.raises(ValueError, match="measured data takes no parameters"):
         bk.model(p, alpha=0.1)
@@ -487,19 +467,10 @@ def test_fuzz_header_fields(tmp_path_factory, which, part, value):
     p = str(tmp_path_factory.mktemp("hfuzz") / "f.bsdf")
     with open(p, "wb") as fh:
         fh.write(bytes(raw))
-    tracemalloc.start()
-    try:
-        try:
-            m = load_rgl(p)
-        except ValueError as e:
-            assert "\n" not in str(e)
-            m = None
-        peak = tracemalloc.get_traced_memory()[1]
-    finally:
-        tracemalloc.stop()
+    m, peak = load_or_one_line_error(load_rgl, p)
     assert peak < 200 * len(_GOOD) + (4 << 20)
     if m is not None:
-        v = m.eval(*random_pairs(50, 1))
+        v = m.eval(*hemisphere_pairs(50, 1))
         assert np.isfinite(v).all() and (v >= 0).all()
 
 

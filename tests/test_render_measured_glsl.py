@@ -21,27 +21,17 @@ import pytest
 import brdfkit as bk
 from brdfkit.measured.merl import MERLBRDF, symmetric_half_diff, tabulate, write_merl_table
 from brdfkit.render import glsl
+from _numeric_helpers import peak_pairs
 
 HALF_PI = np.pi / 2
 
 
-def _hemi(rng, n):
-    v = rng.normal(size=(n, 3))
-    v[:, 2] = np.abs(v[:, 2])
-    return v / np.linalg.norm(v, axis=1, keepdims=True)
-
-
 def _pairs(n=150_000, seed=7):
     """Uniform pairs, pairs near the mirror direction (fine θh bins) and the shared special pairs."""
-    rng = np.random.default_rng(seed)
-    wi, wo = _hemi(rng, n), _hemi(rng, n)
-    wo2 = _hemi(rng, n // 2)
-    wi2 = wo2 * [-1.0, -1.0, 1.0] + rng.normal(size=wo2.shape) * rng.choice([0.002, 0.02, 0.1], size=(n // 2, 1))
-    wi2[:, 2] = np.abs(wi2[:, 2]) + 1e-4
-    wi2 /= np.linalg.norm(wi2, axis=1, keepdims=True)
+    wi, wo = peak_pairs(n, seed)
     pv = glsl.parity_vectors()
-    wi = np.concatenate([wi, wi2, pv["wi"]]).astype(np.float32)
-    wo = np.concatenate([wo, wo2, pv["wo"]]).astype(np.float32)
+    wi = np.concatenate([wi, pv["wi"].astype(np.float32)])
+    wo = np.concatenate([wo, pv["wo"].astype(np.float32)])
     return wi, wo
 
 

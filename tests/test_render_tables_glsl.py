@@ -18,6 +18,7 @@ import pytest
 import brdfkit as bk
 from brdfkit.measured.utia import tabulate_utia, write_utia_table
 from brdfkit.render import glsl, tables
+from _numeric_helpers import peak_pairs
 
 RGL_OPTS = {"resolution": 16, "n_theta": 4, "ndf_resolution": 16}
 
@@ -31,23 +32,6 @@ def files(tmp_path_factory):
     bk.tabulate(aniso, d / "aniso.bsdf", format="rgl", n_phi=5, **RGL_OPTS)
     write_utia_table(tabulate_utia(aniso), d / "ward.bin")
     return {"iso": d / "iso.bsdf", "aniso": d / "aniso.bsdf", "utia": d / "ward.bin"}
-
-
-def _hemi(rng, n):
-    v = rng.normal(size=(n, 3))
-    v[:, 2] = np.abs(v[:, 2])
-    return v / np.linalg.norm(v, axis=1, keepdims=True)
-
-
-def _pairs(n, seed):
-    """Uniform pairs and pairs near the mirror direction (the peak), as float32."""
-    rng = np.random.default_rng(seed)
-    wi, wo = _hemi(rng, n), _hemi(rng, n)
-    wo2 = _hemi(rng, n // 2)
-    wi2 = wo2 * [-1.0, -1.0, 1.0] + rng.normal(size=wo2.shape) * rng.choice([0.002, 0.02, 0.1], size=(n // 2, 1))
-    wi2[:, 2] = np.abs(wi2[:, 2]) + 1e-4
-    wi2 /= np.linalg.norm(wi2, axis=1, keepdims=True)
-    return np.concatenate([wi, wi2]).astype(np.float32), np.concatenate([wo, wo2]).astype(np.float32)
 
 
 def _assert_parity(model, wi, wo, version):
@@ -66,7 +50,7 @@ def test_glsl_twin_equals_the_python_reader(files, which, version):
     m = bk.model(str(files[which]))
     assert glsl.has_shader(m) and glsl.shader_path(m).name == ("utia.glsl" if which == "utia" else "rgl.glsl")
     n = 60_000 if version == "330 core" else 6_000
-    wi, wo = _pairs(n, seed=len(which) + len(version))
+    wi, wo = peak_pairs(n, seed=len(which) + len(version))
     ref = _assert_parity(m, wi, wo, version)
     assert ref.max() > (1.0 if which == "iso" else 0.2)  # a real peak was looked up
     if which != "iso":  # anisotropic: rotating both directions about the normal changes the value
@@ -118,6 +102,34 @@ def test_utia_texture_layout_and_pack_round_trip(files):
     np.testing.assert_array_equal(arrays[0], tex.data)
     with pytest.raises(ValueError, match="only RGL"):
         tables.table_set(bk.model("lambert"))
+
+
+def test_table_set_is_built_once_and_read_only(files):
+    m = bk.model(str(files["aniso"]))
+    ts = tables.table_set(m)
+    assert tables.table_set(m) is ts
+    assert tables.table_set(bk.model(str(files["aniso"]))) is ts  # the same file: the same (digest) key
+    assert all(not t.data.flags.writeable for t in ts.textures)
+    with pytest.raises(ValueError, match="read-only"):
+        ts.textures[0].data[0, 0, 0, 0] = 1.0
+    fresh = tables.rgl_tables(m)  # the builder itself: a new, writable set equal to the held one
+    assert all(t.data.flags.writeable and np.array_equal(t.data, h.data) for t, h in zip(fresh.textures, ts.textures))
+    tables.table_set(bk.model(str(files["iso"])))
+    tables.table_set(bk.model(str(files["utia"])))
+    assert tables.table_set(m) is not ts  # two other sets asked for since: this one was dropped and rebuilt
+
+
+def test_held_keeps_the_last_ones_by_key():
+    held, built = tables.Held(2), []
+
+    def build(v):
+        return lambda: built.append(v) or v
+
+    assert held.get("a", build(1)) == 1 and held.get("b", build(2)) == 2
+    assert held.get("a", build(10)) == 1 and built == [1, 2]  # held: not built again
+    held.get("c", build(3))  # "b" is the least recently used
+    assert len(held) == 2 and held.get("b", build(20)) == 20 and held.get("a", build(30)) == 30
+    assert built == [1, 2, 3, 20, 30]
 
 
 @pytest.mark.parametrize("which", ["aniso", "utia"])

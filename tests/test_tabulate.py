@@ -26,6 +26,7 @@ from brdfkit.measured.rgl import _Params, _Warp, load_rgl
 from brdfkit.measured.tabulation import tabulation_error
 from brdfkit.models.base import BRDF
 from _mitsuba_helpers import mitsuba_f_r
+from _numeric_helpers import hemisphere_pairs
 
 RTOL, FLOOR = 1e-4, 1e-6
 MAX_ERROR = 0.02
@@ -43,18 +44,6 @@ CASES = {
 }
 
 
-def pairs(n, seed, zmin=0.02):
-    rng = np.random.default_rng(seed)
-
-    def dirs():
-        z = rng.uniform(zmin, 1.0, n)
-        p = rng.uniform(-np.pi, np.pi, n)
-        s = np.sqrt(1 - z * z)
-        return np.stack([s * np.cos(p), s * np.sin(p), z], axis=1)
-
-    return dirs(), dirs()
-
-
 def weighted_rms(model_f, file_f, wi, wo) -> float:
     w = (wi[:, 2] * wo[:, 2])[:, None]
     return float(np.sqrt(np.sum(((file_f - model_f) * w) ** 2) / np.sum((model_f * w) ** 2)))
@@ -69,7 +58,7 @@ def written(mi, tmp_path_factory):
     for i, (case, (name, params)) in enumerate(CASES.items()):
         model = bk.model(name, **params)
         res = bk.tabulate(model, d / f"{case}.bsdf", "rgl")
-        wi, wo = pairs(2000, 300 + i)
+        wi, wo = hemisphere_pairs(2000, 300 + i)
         theirs = mitsuba_f_r(mi, {"type": "measured", "filename": res.path}, wi, wo)
         out[case] = (model, res, wi, wo, theirs, load_rgl(res.path).eval(wi, wo))
     return out
@@ -239,7 +228,7 @@ def test_less_symmetric_models_use_the_wider_wedge(mi, tmp_path, kind):
     assert res.shape["reduction"] == kind
     phi = load_rgl(res.path)
     assert phi.reduction == kind
-    wi, wo = pairs(500, 9)
+    wi, wo = hemisphere_pairs(500, 9)
     ours = phi.eval(wi, wo)
     theirs = mitsuba_f_r(mi, {"type": "measured", "filename": res.path}, wi, wo)
     np.testing.assert_allclose(theirs, ours, rtol=RTOL, atol=FLOOR * ours.max())

@@ -101,6 +101,7 @@ import numpy as np
 
 from ..geometry import normalize, random_unit_vectors, reflect, spherical_to_vector
 from .context import EGLCurrent as _EGLCurrent, context_info, create_context
+from .tables import Held, read_only
 
 SHADER_DIR = Path(__file__).resolve().with_name("shaders")
 
@@ -299,21 +300,14 @@ def table_key(model: Any) -> str:
     if key is None:
         from ..measured.merl import MERLBRDF
 
-        from .tables import format_of, table_set
+        from .tables import format_of, table_set_key
 
         if isinstance(model, MERLBRDF):
             import hashlib
 
             key = "merl:" + hashlib.blake2b(np.ascontiguousarray(model.table).tobytes(), digest_size=16).hexdigest()
-        elif format_of(model):
-            import hashlib
-
-            ts = table_set(model)
-            h = hashlib.blake2b(repr(sorted(ts.ints.items())).encode(), digest_size=16)
-            for t in ts.textures:
-                h.update(repr(t.data.shape).encode())
-                h.update(t.data.tobytes())
-            key = f"{ts.format}:{h.hexdigest()}"
+        elif format_of(model):  # a digest of its table set (built once here, and held for table_set)
+            key = table_set_key(model)
         elif hasattr(model, "material"):
             key = f"{type(model).__name__}:{model.material}"
         else:
@@ -325,26 +319,7 @@ def table_key(model: Any) -> str:
     return key
 
 
-@lru_cache(maxsize=2)
-def _texels_cached(key: str, model_ref: Any) -> np.ndarray:
-    from ..measured.merl import table_rgba
-
-    out = table_rgba(model_ref.model)
-    out.setflags(write=False)
-    return out
-
-
-class _Ref:
-    """Carries the model into the lru_cache without making it part of the key."""
-
-    def __init__(self, model: Any) -> None:
-        self.model = model
-
-    def __hash__(self) -> int:
-        return 0
-
-    def __eq__(self, other: object) -> bool:
-        return isinstance(other, _Ref)
+_TEXELS = Held(2)  # the texels of the last two measured tables asked for
 
 
 def table_texels(model: Any) -> np.ndarray:
@@ -359,7 +334,9 @@ def table_texels(model: Any) -> np.ndarray:
     """
     if not is_measured(model):
         raise ValueError(f"table_texels: expected a measured model, got {model!r}")
-    return _texels_cached(table_key(model), _Ref(model))
+    from ..measured.merl import table_rgba
+
+    return _TEXELS.get(table_key(model), lambda: read_only(table_rgba(model)))
 
 
 class TableTextures:

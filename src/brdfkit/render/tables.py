@@ -21,15 +21,26 @@ format     shader        textures (see the shader file's header for what each te
 The arrays are the readers' own working tables (:class:`brdfkit.measured.rgl.RGLBRDF`'s
 normalised VNDF and CDFs computed in float64, spectra already converted to RGB;
 :class:`brdfkit.measured.utia.UTIABRDF`'s table), rounded once to float32.
+
+:func:`table_set` builds a model's set once: the last two sets are held (a :class:`Held`), keyed
+by :func:`brdfkit.render.glsl.table_key` (a digest of the set, so two models read from the same
+file share one), and their arrays are read-only. An anisotropic RGL set takes tens of MB and its
+build about three times that for a moment; the renderer asks for a model's key (which needs the
+set) and then for its set, and may ask again for each frame or evaluation.
 """
 
 from __future__ import annotations
 
+import hashlib
 import json
+import threading
+from collections import OrderedDict
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Callable, Hashable, TypeVar
 
 import numpy as np
+
+_T = TypeVar("_T")
 
 FIRST_UNIT = 8
 #: the formats with a table set here (a model's class ``name``)
@@ -61,6 +72,48 @@ class TableSet:
     shader: str
     textures: tuple[Texture, ...]
     ints: dict[str, int] = field(default_factory=dict)
+
+
+class Held:
+    """The last ``size`` values built, by key (a small LRU whose builder is given per call).
+
+    ``get(key, build)`` returns the value held under ``key``, or calls ``build()``, holds its
+    value and returns it, dropping the least recently used beyond ``size``. Unlike
+    ``functools.lru_cache`` the key is all that is compared: what the build needs (a model) is
+    in the closure. Thread-safe; two threads missing the same key at once both build, and both
+    get the value held first.
+    """
+
+    def __init__(self, size: int = 2) -> None:
+        self.size = size
+        self._values: OrderedDict[Hashable, Any] = OrderedDict()
+        self._lock = threading.Lock()
+
+    def get(self, key: Hashable, build: Callable[[], _T]) -> _T:
+        with self._lock:
+            if key in self._values:
+                self._values.move_to_end(key)
+                return self._values[key]
+        value = build()
+        with self._lock:
+            value = self._values.setdefault(key, value)
+            self._values.move_to_end(key)
+            while len(self._values) > self.size:
+                self._values.popitem(last=False)
+        return value
+
+    def clear(self) -> None:
+        with self._lock:
+            self._values.clear()
+
+    def __len__(self) -> int:
+        return len(self._values)
+
+
+def read_only(a: np.ndarray) -> np.ndarray:
+    """``a``, made read-only (a held array must not be changed by whoever got it)."""
+    a.flags.writeable = False
+    return a
 
 
 def format_of(model: Any) -> str | None:
@@ -111,14 +164,48 @@ def utia_tables(model: Any) -> TableSet:
     return TableSet("utia", "utia.glsl", (Texture("u_utia", _f32(rgba)),))
 
 
-def table_set(model: Any) -> TableSet:
-    """The :class:`TableSet` of an RGL or UTIA model; ``ValueError`` for any other."""
+_BUILDERS = {"rgl": rgl_tables, "utia": utia_tables}
+_SETS = Held(2)  # the table sets of the last two models asked for
+
+
+def _format_or_error(model: Any) -> str:
     fmt = format_of(model)
-    if fmt == "rgl":
-        return rgl_tables(model)
-    if fmt == "utia":
-        return utia_tables(model)
-    raise ValueError(f"no GLSL table set for {model!r} (only RGL .bsdf and UTIA .bin models have one)")
+    if fmt is None:
+        raise ValueError(f"no GLSL table set for {model!r} (only RGL .bsdf and UTIA .bin models have one)")
+    return fmt
+
+
+def _built(model: Any, fmt: str) -> TableSet:
+    ts = _BUILDERS[fmt](model)
+    for t in ts.textures:
+        read_only(t.data)
+    return ts
+
+
+def table_set(model: Any) -> TableSet:
+    """The :class:`TableSet` of an RGL or UTIA model; ``ValueError`` for any other.
+
+    Built once and held (the last two models' sets, keyed by
+    :func:`brdfkit.render.glsl.table_key`): its arrays are read-only; copy one to change it."""
+    fmt = _format_or_error(model)
+    from .glsl import table_key
+
+    key = table_key(model)  # for a model not seen before: builds its set and holds it (table_set_key)
+    return _SETS.get(key, lambda: _built(model, fmt))
+
+
+def table_set_key(model: Any) -> str:
+    """The key of an RGL or UTIA model's table set (:func:`brdfkit.render.glsl.table_key` for such a
+    model): ``format:`` and a digest of the set's ints and textures. Builds the set and holds it
+    under that key, so that :func:`table_set` finds it."""
+    ts = _built(model, _format_or_error(model))
+    h = hashlib.blake2b(repr(sorted(ts.ints.items())).encode(), digest_size=16)
+    for t in ts.textures:
+        h.update(repr(t.data.shape).encode())
+        h.update(np.ascontiguousarray(t.data))  # the bytes of tobytes(), without copying them
+    key = f"{ts.format}:{h.hexdigest()}"
+    _SETS.get(key, lambda: ts)
+    return key
 
 
 # ---------------------------------------------------------------------------
@@ -159,4 +246,4 @@ def unpack(data: bytes) -> tuple[dict[str, Any], list[np.ndarray]]:
 
 
 __all__ = ["Texture", "TableSet", "FIRST_UNIT", "FORMATS", "format_of", "rgl_tables", "utia_tables", "table_set",
-           "header", "pack", "unpack"]
+           "table_set_key", "Held", "read_only", "header", "pack", "unpack"]
