@@ -104,7 +104,7 @@ def main(argv: list[str] | None = None) -> int:
         t.add_row(r["case"], r["dtype"], str(r["outputs_per_pair"]), f"{r['eval_mpairs_per_s']:.1f}",
                   f"{r['grad_mpairs_per_s']:.2f}", f"{r['grad_vs_eval']:.3f}", r["wrt"],
                   f"{r['grad_wrt_mpairs_per_s']:.2f}", f"{r['grad_wrt_vs_eval']:.3f}")
-    Console().print(t)
+    Console(width=150).print(t)
     return 0
 
 

@@ -23,6 +23,8 @@ allocate more than the file holds nor read past its end: any defect is one
 
 from __future__ import annotations
 
+import math
+
 import os
 import struct
 from typing import Mapping
@@ -116,7 +118,7 @@ def read_tensor_file(path: str | os.PathLike) -> dict[str, np.ndarray]:
         name, dtype, offset, shape = _field_header(cur, size)
         if name in fields:
             raise ValueError(f"{path}: field {name!r} appears twice")
-        count = int(np.prod(shape, dtype=object)) if shape else 1
+        count = math.prod(int(s) for s in shape)  # Python ints: a huge dimension beside a 0 cannot overflow
         arr = np.frombuffer(data, dtype=dtype, count=count, offset=offset).reshape(shape)
         fields[name] = arr
     return fields
