@@ -50,9 +50,9 @@ JOIN_RTOL = 1e-3
 
 #: use the model's exact Jacobian (its ``eval_grad`` for the free parameters only,
 #: :mod:`brdfkit.measured.exact_jacobian`) where it has one; False: forward differences for every
-#: model, as before issue 31. Measured (benchmarks/bench_fit.py --jacobian, docs/speed.md): the same
-#: losses to 1e-8 with 30-65 % fewer evaluations, wall times within ±15 % of the differences' (the
-#: gradient pass costs several value passes per pair). The environment variable
+#: model, as before issue 31. Measured (benchmarks/bench_fit.py --jacobian, docs/speed.md; 6 MERL
+#: materials × 5 models, warm): the same losses to 3e-8, 30-65 % fewer evaluations, wall time 0.78-1.23×
+#: the differences' (median 1.07×: a gradient pass costs several value passes per pair). The variable
 #: ``BRDFKIT_FIT_JACOBIAN=differences`` sets it False in every process (a batch's workers included).
 EXACT_JACOBIAN = os.environ.get("BRDFKIT_FIT_JACOBIAN", "exact") != "differences"
 
