@@ -101,7 +101,7 @@ import numpy as np
 
 from ..geometry import normalize, random_unit_vectors, reflect, spherical_to_vector
 from .context import EGLCurrent as _EGLCurrent, context_info, create_context
-from .tables import Held, read_only
+from .tables import KEY_ATTR, Held, read_only
 
 SHADER_DIR = Path(__file__).resolve().with_name("shaders")
 
@@ -296,7 +296,7 @@ _TABLE_CACHE_SIZE = 4  # textures kept per GL context (about 23 MB each)
 def table_key(model: Any) -> str:
     """A key identifying a measured model's table: the material for a Neural-BRDF
     material, a digest of the table for a MERL table (computed once per instance)."""
-    key = getattr(model, "_bk_table_key", None)
+    key = getattr(model, KEY_ATTR, None)
     if key is None:
         from ..measured.merl import MERLBRDF
 
@@ -313,7 +313,7 @@ def table_key(model: Any) -> str:
         else:
             key = f"{type(model).__name__}:{id(model)}"
         try:
-            object.__setattr__(model, "_bk_table_key", key)
+            object.__setattr__(model, KEY_ATTR, key)
         except AttributeError:  # pragma: no cover - a model without a __dict__
             pass
     return key

@@ -182,15 +182,23 @@ def _built(model: Any, fmt: str) -> TableSet:
     return ts
 
 
+#: the attribute a model's table key is kept in once computed (:func:`brdfkit.render.glsl.table_key` too)
+KEY_ATTR = "_bk_table_key"
+
+
 def table_set(model: Any) -> TableSet:
     """The :class:`TableSet` of an RGL or UTIA model; ``ValueError`` for any other.
 
-    Built once and held (the last two models' sets, keyed by
-    :func:`brdfkit.render.glsl.table_key`): its arrays are read-only; copy one to change it."""
+    Built once and held (the last two models' sets, keyed by :func:`table_set_key`, which is
+    :func:`brdfkit.render.glsl.table_key` for such a model): its arrays are read-only; copy one to change it."""
     fmt = _format_or_error(model)
-    from .glsl import table_key
-
-    key = table_key(model)  # for a model not seen before: builds its set and holds it (table_set_key)
+    key = getattr(model, KEY_ATTR, None)
+    if key is None:  # a model not seen before: table_set_key builds its set and holds it
+        key = table_set_key(model)
+        try:
+            object.__setattr__(model, KEY_ATTR, key)
+        except AttributeError:  # pragma: no cover - a model without a __dict__
+            pass
     return _SETS.get(key, lambda: _built(model, fmt))
 
 
