@@ -96,10 +96,11 @@ _MATH_UNARY = {
 class _Func:
     """The transformation of one source function for one pattern of its arguments."""
 
-    def __init__(self, fn: Callable, arg_patterns: tuple, seeds: frozenset):
+    def __init__(self, fn: Callable, arg_patterns: tuple, seeds: frozenset, direction: int | None = None):
         self.fn = fn
         self.py = getattr(fn, "py_func", fn)
         self.seeds = seeds
+        self.direction = direction  # None: a tangent per seed; else one tangent, p[k]'s being p[direction + k]
         src = textwrap.dedent(inspect.getsource(self.py))
         tree = ast.parse(src)
         self.fdef = tree.body[0]
@@ -228,7 +229,7 @@ class _Func:
     def _call_pats(self, call: ast.Call) -> tuple:
         obj = self._callee(call)
         pats = tuple(self._arg_pat(a) for a in call.args)
-        _, rets = forward_function(obj, pats, self.seeds)
+        _, rets = forward_function(obj, pats, self.seeds, self.direction)
         return rets
 
     def epat(self, e) -> frozenset:
@@ -252,7 +253,7 @@ class _Func:
             v = e.value
             k = self.static_int(e.slice)
             if isinstance(v, ast.Name) and self.arg_patterns.get(v.id) == P_ARRAY and k is not None and k in self.seeds:
-                return frozenset([k])
+                return frozenset([0 if self.direction is not None else k])
             return EMPTY  # a table in p, or another array: a constant
         if isinstance(e, ast.Attribute):
             return EMPTY
@@ -423,7 +424,7 @@ class _Func:
             argsrc.append(v)
             if isinstance(ap, frozenset):
                 argsrc.extend(d.get(j, "0.0") for j in sorted(ap))
-        twin, rets = forward_function(obj, tuple(pats), self.seeds)
+        twin, rets = forward_function(obj, tuple(pats), self.seeds, self.direction)
         gname = f"_fwd_{len(self.callees)}"
         self.callees[gname] = (twin, rets)
         t = self.tmp()
@@ -454,6 +455,8 @@ class _Func:
             pat = self.epat(e)
             ls, v, _ = self.dual(e.value)
             ls2, s, _ = self.dual(e.slice)
+            if pat and self.direction is not None:  # the direction's component: p[direction + k]
+                return ls + ls2, f"{v}[{s}]", {0: f"{v}[{self.direction + self.static_int(e.slice)}]"}
             return ls + ls2, f"{v}[{s}]", {j: "1.0" for j in pat}
         if isinstance(e, (ast.Compare, ast.BoolOp)) or (isinstance(e, ast.UnaryOp) and isinstance(e.op, ast.Not)):
             # operands may call jitted functions: evaluate them first (their values only)
@@ -693,8 +696,11 @@ def _module_source(tr: _Func, fsrc: str) -> str:
     head.append("")
     # inline="never": numba's IR inlining of a twin and its callees (f_conductor's 280 lines once per channel)
     # took 217 s to compile one microfacet configuration cold on the development machine; compiled
-    # separately (each twin once, shared by every configuration), 56 s, and 10-18 s for the next ones
-    head.append('@numba.njit(cache=True, error_model="numpy", nogil=True)')
+    # separately (each twin once, shared by every configuration), 56 s, and 10-18 s for the next ones.
+    # A directional twin (one tangent) is small enough to inline (16 s cold for GGX conductor), and only
+    # inlined does its driver's loop vectorise across pairs (grad.DIRECTIONAL_TEMPLATE)
+    inline = ', inline="always"' if tr.direction is not None else ""
+    head.append(f'@numba.njit(cache=True, error_model="numpy", nogil=True{inline})')
     return "\n".join(head) + "\n" + fsrc
 
 
@@ -727,35 +733,37 @@ def _seed_str(seeds: frozenset) -> str:
     return "s" + "-".join(str(k) for k in sorted(seeds))
 
 
-def forward_function(fn: Callable, arg_patterns: tuple, seeds) -> tuple[Callable, tuple]:
+def forward_function(fn: Callable, arg_patterns: tuple, seeds, direction: int | None = None) -> tuple[Callable, tuple]:
     """``(twin, return patterns)``: ``fn``'s forward twin for arguments whose tangent components are
     ``arg_patterns`` (a frozenset per argument, :data:`P_ARRAY` for the parameter array). Where no
     argument carries a tangent, ``fn`` itself (its results carry none). ``seeds``: the indices ``k`` whose
-    ``p[k]`` is differentiated (an int ``n``: all of ``0 … n−1``)."""
+    ``p[k]`` is differentiated (an int ``n``: all of ``0 … n−1``). ``direction``: None, a tangent per seed;
+    else ONE tangent, the derivative along the direction whose ``k``-th component is ``p[direction + k]``
+    (the caller appends the direction to ``p``)."""
     seeds = _seed_set(seeds)
     py = getattr(fn, "py_func", fn)
     if all(not (p == P_ARRAY or isinstance(p, frozenset) and p) for p in arg_patterns):
         # nothing flows in: the original, its results constants (arity from a trial analysis)
-        key = (id(py), arg_patterns, seeds)
+        key = (id(py), arg_patterns, seeds, direction)
         with _LOCK:
             hit = _TWINS.get(key)
             if hit is None:
-                tr = _Func(fn, arg_patterns, seeds)
+                tr = _Func(fn, arg_patterns, seeds, direction)
                 tr.analyse()
                 hit = _TWINS[key] = (fn, tuple(tr.ret or [EMPTY]))
         return hit
-    key = (id(py), arg_patterns, seeds)
+    key = (id(py), arg_patterns, seeds, direction)
     with _LOCK:
         hit = _TWINS.get(key)
         if hit is not None:
             return hit
-        tr = _Func(fn, arg_patterns, seeds)
+        tr = _Func(fn, arg_patterns, seeds, direction)
         try:
             fsrc = tr.generate()
         except Unsupported as e:
             msg = str(e)
             raise Unsupported(msg if msg.startswith("in ") else f"in {py.__qualname__}: {msg}") from None
-        stem = (f"fwd_{py.__module__}_{py.__name__}__{_seed_str(seeds)}__" + "_".join(_pat_str(p) for p in arg_patterns))
+        stem = (f"fwd_{py.__module__}_{py.__name__}__{_seed_str(seeds)}{'' if direction is None else f'v{direction}'}__" + "_".join(_pat_str(p) for p in arg_patterns))
         stem = stem.replace(".", "_")
         if len(stem) > 180:
             import hashlib
@@ -773,12 +781,13 @@ def _load(stem: str, src: str, name: str) -> Callable:
     return getattr(load_generated("forward", stem, src, "brdfkit._engine_forward"), name)
 
 
-def forward_kernel(kernel: Callable, seeds) -> tuple[Callable, tuple]:
+def forward_kernel(kernel: Callable, seeds, direction: int | None = None) -> tuple[Callable, tuple]:
     """The forward twin of a model kernel ``kernel(wix, wiy, wiz, wox, woy, woz, p, c)`` seeded by
     ``p[k]`` for each ``k`` in ``seeds`` (an int ``n``: ``p[0..n)``): it returns ``(r, r__d…, g, g__d…,
-    b, b__d…)``, with the tangent components of each channel listed in the returned patterns."""
+    b, b__d…)``, with the tangent components of each channel listed in the returned patterns; with a
+    ``direction`` (:func:`forward_function`), one tangent per channel at most."""
     pats = (EMPTY,) * 6 + (P_ARRAY, EMPTY)
-    twin, rets = forward_function(kernel, pats, seeds)
+    twin, rets = forward_function(kernel, pats, seeds, direction)
     if len(rets) != 3:
         raise Unsupported("a kernel must return three channels")
     return twin, rets
