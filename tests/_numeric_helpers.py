@@ -16,6 +16,8 @@ from typing import Any, Callable
 
 import numpy as np
 
+from brdfkit.geometry import random_unit_vectors
+
 
 def lifted_pairs(n: int, seed: int, lift: float) -> tuple[np.ndarray, np.ndarray]:
     """``n`` pairs (wi, wo) of unit vectors: normal draws with ``z = |z| + lift``, then normalised."""
@@ -43,20 +45,13 @@ def hemisphere_pairs(n: int, seed: int, zmin: float = 0.02) -> tuple[np.ndarray,
     return dirs(), dirs()
 
 
-def hemisphere_vectors(rng: np.random.Generator, n: int) -> np.ndarray:
-    """``n`` unit vectors uniform on the upper hemisphere (normal draws, ``|z|``, normalised)."""
-    v = rng.normal(size=(n, 3))
-    v[:, 2] = np.abs(v[:, 2])
-    return v / np.linalg.norm(v, axis=1, keepdims=True)
-
-
 def peak_pairs(n: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
     """``n`` uniform pairs then ``n // 2`` pairs near the mirror direction (``wi`` = the mirror of
     ``wo`` moved by normal draws of scale 0.002, 0.02 or 0.1: the peak of a lobe, where a table's
     finest bins are), as float32."""
     rng = np.random.default_rng(seed)
-    wi, wo = hemisphere_vectors(rng, n), hemisphere_vectors(rng, n)
-    wo2 = hemisphere_vectors(rng, n // 2)
+    wi, wo = random_unit_vectors(n, rng), random_unit_vectors(n, rng)
+    wo2 = random_unit_vectors(n // 2, rng)
     wi2 = wo2 * [-1.0, -1.0, 1.0] + rng.normal(size=wo2.shape) * rng.choice([0.002, 0.02, 0.1], size=(n // 2, 1))
     wi2[:, 2] = np.abs(wi2[:, 2]) + 1e-4
     wi2 /= np.linalg.norm(wi2, axis=1, keepdims=True)

@@ -155,41 +155,44 @@ def layout(model) -> list[tuple[str, int, int]]:
     return out
 
 
-def _wanted(model, lay, wrt) -> list[tuple[str, int, int]]:
-    """The part of ``lay`` that ``wrt`` asks for (None: all of it); ValueError naming an unknown name."""
-    if wrt is None:
-        return lay
-    names = [wrt] if isinstance(wrt, str) else list(wrt)
-    have = {n for n, _, _ in lay}
-    alias = {"alpha": ("alpha_x", "alpha_y")} if "alpha_x" in have and model.params.get("alpha") is not None else {}
-    want: set[str] = set()
+def _asked(model, lay, wrt) -> list[str]:
+    """The parameter names ``wrt`` asks for (None: every continuous one, and microfacet's ``alpha``
+    where it sets both axes), checked against ``lay``, each once, in order; ValueError naming an unknown one."""
+    have = [n for n, _, _ in lay]
+    alias = "alpha_x" in have and "alpha" not in have and model.params.get("alpha") is not None
+    names = (have + (["alpha"] if alias else [])) if wrt is None else ([wrt] if isinstance(wrt, str) else list(wrt))
     for n in names:
         if not isinstance(n, str):
             raise ValueError(f"{model.name}: wrt must be parameter names; got {n!r}")
-        if n in alias:
-            want.update(alias[n])
-        elif n in have:
-            want.add(n)
-        else:
-            raise ValueError(f"{model.name}: no gradient with respect to {n!r} "
-                             f"(continuous parameters: {', '.join(sorted(have | set(alias)))})")
+        if n not in have and not (alias and n == "alpha"):
+            known = sorted(have + (["alpha"] if alias else []))
+            raise ValueError(f"{model.name}: no gradient with respect to {n!r} (continuous parameters: {', '.join(known)})")
+    return list(dict.fromkeys(names))
+
+
+def _components(lay, names: list[str]) -> list[tuple[str, int, int]]:
+    """The part of ``lay`` that ``names`` needs (microfacet's ``alpha``: both axes)."""
+    want = set(names) | ({"alpha_x", "alpha_y"} if "alpha" in names else set())
     return [t for t in lay if t[0] in want]
 
 
-def _grad_driver(model, kernel, choices: tuple, f32: bool, seeds: tuple):
-    twin, rets = forward_kernel(kernel, seeds)
+def _source(template: str, kernel, twin, choices: tuple, f32: bool, stem: str, **fields):
+    """``(stem, source)`` of a gradient driver module: ``template`` formatted for ``kernel``'s ``twin``."""
     py = getattr(kernel, "py_func", kernel)
     key = _KEY_OF[id(twin)]
-    kline = "float32_twin(_k, inline=True)" if f32 else "_k"
-    col = {k: i for i, k in enumerate(seeds)}
-    src = GRAD_TEMPLATE.format(module=py.__module__, name=py.__name__, key=key, kernel_line=kline, what="",
-                               npairs="wi.shape[0]", choices=repr(choices), chunk=_driver.CHUNK,
-                               stores=_stores(rets, col),
-                               F="numba.float32" if f32 else "numba.float64",
-                               FM="{'contract'}" if f32 else "False")
-    stem = f"grad_{key}{'__f32' if f32 else ''}__c" + "_".join(str(v) for v in choices)
-    dkey = ("grad", py.__module__, py.__name__, seeds, f32, choices)
-    return _load(dkey, stem[:200], src), rets
+    src = template.format(module=py.__module__, name=py.__name__, key=key, choices=repr(choices),
+                          chunk=_driver.CHUNK, kernel_line="float32_twin(_k, inline=True)" if f32 else "_k",
+                          F="numba.float32" if f32 else "numba.float64", FM="{'contract'}" if f32 else "False",
+                          **fields)
+    return f"{stem}_{key}{'__f32' if f32 else ''}__c" + "_".join(str(v) for v in choices), src
+
+
+def _grad_driver(kernel, choices: tuple, f32: bool, seeds: tuple):
+    twin, rets = forward_kernel(kernel, seeds)
+    stem, src = _source(GRAD_TEMPLATE, kernel, twin, choices, f32, "grad", what="", npairs="wi.shape[0]",
+                        stores=_stores(rets, {k: i for i, k in enumerate(seeds)}))
+    py = getattr(kernel, "py_func", kernel)
+    return _load(("grad", py.__module__, py.__name__, seeds, f32, choices), stem[:200], src)
 
 
 def _directional_stores(rets) -> str:
@@ -210,26 +213,19 @@ def _directional_driver(kernel, choices: tuple, f32: bool, n: int, off: int):
     """The driver of ``kernel``'s directional twin: ``p``'s numeric components ``0 … n−1`` differentiated
     along the direction stored at ``p[off:off + n]``."""
     twin, rets = forward_kernel(kernel, n, off)
+    stem, src = _source(DIRECTIONAL_TEMPLATE, kernel, twin, choices, f32, "dgrad", what=", along a direction",
+                        npairs="wi.shape[0] // 3", stores=_directional_stores(rets))
     py = getattr(kernel, "py_func", kernel)
-    key = _KEY_OF[id(twin)]
-    src = DIRECTIONAL_TEMPLATE.format(module=py.__module__, name=py.__name__, key=key, what=", along a direction",
-                                      npairs="wi.shape[0] // 3",
-                                      kernel_line="float32_twin(_k, inline=True)" if f32 else "_k",
-                                      choices=repr(choices), chunk=_driver.CHUNK, stores=_directional_stores(rets),
-                                      F="numba.float32" if f32 else "numba.float64",
-                                      FM="{'contract'}" if f32 else "False")
-    stem = f"dgrad_{key}{'__f32' if f32 else ''}__c" + "_".join(str(v) for v in choices)
     return _load(("dgrad", py.__module__, py.__name__, n, off, f32, choices), stem[:200], src)
 
 
-def _directions(model, lay, wrt) -> list[tuple[str, int | None, np.ndarray]]:
-    """``(name, channel or None, direction over p's numeric components)`` per derivative ``wrt`` asks for."""
+def _directions(lay, names: list[str]) -> list[tuple[str, int | None, np.ndarray]]:
+    """``(name, channel or None, direction over p's numeric components)`` per derivative of ``names``."""
     n = sum(size for _, _, size in lay)
     where = {name: (off, size) for name, off, size in lay}
-    names = [wrt] if isinstance(wrt, str) else list(wrt)
     out = []
-    for name in dict.fromkeys(names):
-        if name == "alpha" and name not in where:  # microfacet's alpha sets both axes
+    for name in names:
+        if name not in where:  # microfacet's alpha (_asked): it sets both axes
             v = np.zeros(n)
             v[where["alpha_x"][0]] = v[where["alpha_y"][0]] = 1.0
             out.append((name, None, v))
@@ -281,18 +277,20 @@ def eval_grad(model, wi, wo, wrt=None):
         raise ValueError(f"{name}: no gradient with multiscatter=true (its compensation table is precomputed "
                          f"per parameter set, outside the kernel's source)")
     full = layout(model)
-    lay = _wanted(model, full, wrt)
+    names = _asked(model, full, wrt)
+    lay = _components(full, names)
     seeds = tuple(k for _, off, size in lay for k in range(off, off + size))
     n = len(seeds)
     p, c = model.kernel_args()
     fi, fo, shape, dtype = prepare(name, wi, wo)
     npairs = fi.shape[0]
-    if npairs and wrt is not None and engine() == "compiled":
+    f32 = dtype == np.float32 and getattr(type(model), "kernel_float32", True) and fits_float32(p)
+    ft = np.float32 if f32 else np.float64
+    if npairs and wrt is not None and engine() == "compiled" and np.dtype(dtype) == ft:
         # a few derivatives asked for by name: one vectorised pass each (f to the last bit of eval's:
         # the vectorised loop may call the vector math library where eval's scalar loop calls libm)
-        f32 = dtype == np.float32 and getattr(type(model), "kernel_float32", True) and fits_float32(p)
-        dirs = _directions(model, full, wrt)
-        if len(dirs) <= DIRECTIONAL_MAX and np.dtype(dtype) == (np.float32 if f32 else np.float64):
+        dirs = _directions(full, names)
+        if len(dirs) <= DIRECTIONAL_MAX:
             try:
                 return _eval_directional(model, kernel, p, c, fi, fo, shape, f32, dirs, sum(s for _, _, s in full))
             except Unsupported as e:
@@ -304,11 +302,9 @@ def eval_grad(model, wi, wo, wrt=None):
         if npairs == 0:
             pass
         elif engine() == "compiled":
-            f32 = dtype == np.float32 and getattr(type(model), "kernel_float32", True) and fits_float32(p)
-            ft = np.float32 if f32 else np.float64
             choices = tuple(int(v) for v in c)
             with _LOCK:
-                drive, _ = _grad_driver(model, kernel, choices, f32, seeds)
+                drive = _grad_driver(kernel, choices, f32, seeds)
             pt = _driver.param_tuple(p, ft)
             w_i, w_o = _driver.read_only(fi), _driver.read_only(fo)
             bad = np.zeros(_driver.nchunks(npairs), dtype=np.int64)
@@ -340,12 +336,9 @@ def eval_grad(model, wi, wo, wrt=None):
     for pname, _, size in lay:
         grads[pname] = g[..., col] if size == 1 else g[..., col:col + size]
         col += size
-    if "alpha_x" in grads and "alpha_y" in grads and model.params.get("alpha") is not None:
+    if "alpha" in names:
         grads["alpha"] = grads["alpha_x"] + grads["alpha_y"]  # alpha sets both
-    if wrt is not None:
-        asked = {wrt} if isinstance(wrt, str) else set(wrt)
-        grads = {k: v for k, v in grads.items() if k in asked}
-    return f, grads
+    return f, {k: grads[k] for k in names}
 
 
 def _eval_directional(model, kernel, p, c, fi, fo, shape, f32: bool, dirs, n: int):

@@ -88,13 +88,14 @@ def exact_jacobian(packer: ParamPacker, data: Samples, metric: str) -> Callable[
     if len(packer) == 0:
         return None
     prepared = PreparedEval(packer, data)
+    # only the free parameters' derivatives (and their ties'): a twin seeded by fewer does less work,
+    # and the probe below compiles or loads the same twin as every later call
+    wrt = sorted({n for s in packer.slots for n in (s.param.name, packer.tied.get(s.param.name)) if n is not None})
     try:
-        _, grads = prepared.model(packer.x_of(packer.fixed)).eval_grad(data.wi[:1], data.wo[:1])
+        _, grads = prepared.model(packer.x_of(packer.fixed)).eval_grad(data.wi[:1], data.wo[:1], wrt=wrt)
         columns = _columns(packer, grads)
     except (ValueError, NotImplementedError, AttributeError):
         return None
-    # only the free parameters' derivatives: a twin seeded by fewer parameters does less work
-    wrt = sorted({nm for name, _, twin in columns for nm in (name, twin) if nm is not None})
     c = data.cos_i[:, None]
     n = len(data)
     # the residuals' weights: √w_j / √(3n), as residual_fn folds them

@@ -24,7 +24,6 @@ allocate more than the file holds nor read past its end: any defect is one
 from __future__ import annotations
 
 import math
-
 import os
 import struct
 from typing import Mapping

@@ -29,11 +29,11 @@ The parameters of :func:`microsurface` are tabled in :class:`Microsurface`'s tex
 
 from __future__ import annotations
 
-from collections import OrderedDict
-from typing import Any, Callable, NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 
+from ..memo import Held
 from ..models.microfacet import Microfacet, fresnel_term
 from . import surfaces as _surf
 from .engines import ENGINES, MitsubaEngine, available, make_engine
@@ -43,22 +43,11 @@ from .tracer import EPS_REL, Paths, propagate, trace
 KINDS = ("v-groove", "beckmann", "ggx")
 CORR_CELLS = 6.0  # correlation length of the random tiles, in grid cells
 
-#: tiles and engines kept between calls, each cache its ``_KEEP`` most recently used (a 512² tile and
-#: its engine's scene are tens of MB); keyed by the tile's parameters, so an equal tile finds its engine
+#: tiles and engines kept between calls, the ``_KEEP`` most recently used of each (a 512² tile and its
+#: engine's scene are tens of MB); keyed by the tile's parameters, so an equal tile finds its engine
 _KEEP = 4
-_TILES: OrderedDict[tuple, Tile] = OrderedDict()
-_ENGINES: OrderedDict[tuple, MitsubaEngine] = OrderedDict()
-
-
-def _cached(cache: OrderedDict, key: tuple, make: Callable[[], Any]) -> Any:
-    """``cache[key]``, made by ``make()`` when missing; the least recently used beyond ``_KEEP`` are dropped."""
-    if key in cache:
-        cache.move_to_end(key)
-        return cache[key]
-    value = cache[key] = make()
-    while len(cache) > _KEEP:
-        cache.popitem(last=False)
-    return value
+_TILES = Held(_KEEP)
+_ENGINES = Held(_KEEP)
 
 
 class Estimate(NamedTuple):
@@ -168,12 +157,12 @@ class Microsurface:
     @property
     def tile(self) -> Tile:
         if self.kind == "v-groove":
-            return _cached(_TILES, self._tile_key, lambda: _surf.v_groove(self.angle))
-        return _cached(_TILES, self._tile_key, lambda: _surf.gaussian_field(self.resolution, CORR_CELLS, self.seed))
+            return _TILES.get(self._tile_key, lambda: _surf.v_groove(self.angle))
+        return _TILES.get(self._tile_key, lambda: _surf.gaussian_field(self.resolution, CORR_CELLS, self.seed))
 
     @property
     def engine(self) -> MitsubaEngine:
-        return _cached(_ENGINES, self._tile_key + (self.engine_name,), lambda: make_engine(self.tile, self.engine_name))
+        return _ENGINES.get(self._tile_key + (self.engine_name,), lambda: make_engine(self.tile, self.engine_name))
 
     def scales(self, n: int) -> _surf.Scales:
         """Base → world maps for ``n`` rays (a fresh mixture weight per ray for GGX)."""

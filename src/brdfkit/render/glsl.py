@@ -101,7 +101,7 @@ import numpy as np
 
 from ..geometry import normalize, random_unit_vectors, reflect, spherical_to_vector
 from .context import EGLCurrent as _EGLCurrent, context_info, create_context
-from .tables import KEY_ATTR, Held, read_only
+from .tables import Held, kept_key, read_only
 
 SHADER_DIR = Path(__file__).resolve().with_name("shaders")
 
@@ -296,27 +296,23 @@ _TABLE_CACHE_SIZE = 4  # textures kept per GL context (about 23 MB each)
 def table_key(model: Any) -> str:
     """A key identifying a measured model's table: the material for a Neural-BRDF
     material, a digest of the table for a MERL table (computed once per instance)."""
-    key = getattr(model, KEY_ATTR, None)
-    if key is None:
-        from ..measured.merl import MERLBRDF
+    return kept_key(model, lambda: _table_key(model))
 
-        from .tables import format_of, table_set_key
 
-        if isinstance(model, MERLBRDF):
-            import hashlib
+def _table_key(model: Any) -> str:
+    from ..measured.merl import MERLBRDF
 
-            key = "merl:" + hashlib.blake2b(np.ascontiguousarray(model.table).tobytes(), digest_size=16).hexdigest()
-        elif format_of(model):  # a digest of its table set (built once here, and held for table_set)
-            key = table_set_key(model)
-        elif hasattr(model, "material"):
-            key = f"{type(model).__name__}:{model.material}"
-        else:
-            key = f"{type(model).__name__}:{id(model)}"
-        try:
-            object.__setattr__(model, KEY_ATTR, key)
-        except AttributeError:  # pragma: no cover - a model without a __dict__
-            pass
-    return key
+    from .tables import format_of, table_set_key
+
+    if isinstance(model, MERLBRDF):
+        import hashlib
+
+        return "merl:" + hashlib.blake2b(np.ascontiguousarray(model.table).tobytes(), digest_size=16).hexdigest()
+    if format_of(model):  # a digest of its table set (built once here, and held for table_set)
+        return table_set_key(model)
+    if hasattr(model, "material"):
+        return f"{type(model).__name__}:{model.material}"
+    return f"{type(model).__name__}:{id(model)}"
 
 
 _TEXELS = Held(2)  # the texels of the last two measured tables asked for

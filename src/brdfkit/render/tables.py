@@ -22,7 +22,7 @@ The arrays are the readers' own working tables (:class:`brdfkit.measured.rgl.RGL
 normalised VNDF and CDFs computed in float64, spectra already converted to RGB;
 :class:`brdfkit.measured.utia.UTIABRDF`'s table), rounded once to float32.
 
-:func:`table_set` builds a model's set once: the last two sets are held (a :class:`Held`), keyed
+:func:`table_set` builds a model's set once: the last two sets are held (a :class:`brdfkit.memo.Held`), keyed
 by :func:`brdfkit.render.glsl.table_key` (a digest of the set, so two models read from the same
 file share one), and their arrays are read-only. An anisotropic RGL set takes tens of MB and its
 build about three times that for a moment; the renderer asks for a model's key (which needs the
@@ -33,14 +33,12 @@ from __future__ import annotations
 
 import hashlib
 import json
-import threading
-from collections import OrderedDict
 from dataclasses import dataclass, field
-from typing import Any, Callable, Hashable, TypeVar
+from typing import Any, Callable
 
 import numpy as np
 
-_T = TypeVar("_T")
+from ..memo import Held
 
 FIRST_UNIT = 8
 #: the formats with a table set here (a model's class ``name``)
@@ -72,42 +70,6 @@ class TableSet:
     shader: str
     textures: tuple[Texture, ...]
     ints: dict[str, int] = field(default_factory=dict)
-
-
-class Held:
-    """The last ``size`` values built, by key (a small LRU whose builder is given per call).
-
-    ``get(key, build)`` returns the value held under ``key``, or calls ``build()``, holds its
-    value and returns it, dropping the least recently used beyond ``size``. Unlike
-    ``functools.lru_cache`` the key is all that is compared: what the build needs (a model) is
-    in the closure. Thread-safe; two threads missing the same key at once both build, and both
-    get the value held first.
-    """
-
-    def __init__(self, size: int = 2) -> None:
-        self.size = size
-        self._values: OrderedDict[Hashable, Any] = OrderedDict()
-        self._lock = threading.Lock()
-
-    def get(self, key: Hashable, build: Callable[[], _T]) -> _T:
-        with self._lock:
-            if key in self._values:
-                self._values.move_to_end(key)
-                return self._values[key]
-        value = build()
-        with self._lock:
-            value = self._values.setdefault(key, value)
-            self._values.move_to_end(key)
-            while len(self._values) > self.size:
-                self._values.popitem(last=False)
-        return value
-
-    def clear(self) -> None:
-        with self._lock:
-            self._values.clear()
-
-    def __len__(self) -> int:
-        return len(self._values)
 
 
 def read_only(a: np.ndarray) -> np.ndarray:
@@ -186,19 +148,25 @@ def _built(model: Any, fmt: str) -> TableSet:
 KEY_ATTR = "_bk_table_key"
 
 
+def kept_key(model: Any, compute: Callable[[], str]) -> str:
+    """``model``'s table key, computed once by ``compute()`` and kept on the instance (:data:`KEY_ATTR`)."""
+    key = getattr(model, KEY_ATTR, None)
+    if key is None:
+        key = compute()
+        try:
+            object.__setattr__(model, KEY_ATTR, key)
+        except AttributeError:  # pragma: no cover - a model without a __dict__
+            pass
+    return key
+
+
 def table_set(model: Any) -> TableSet:
     """The :class:`TableSet` of an RGL or UTIA model; ``ValueError`` for any other.
 
     Built once and held (the last two models' sets, keyed by :func:`table_set_key`, which is
     :func:`brdfkit.render.glsl.table_key` for such a model): its arrays are read-only; copy one to change it."""
     fmt = _format_or_error(model)
-    key = getattr(model, KEY_ATTR, None)
-    if key is None:  # a model not seen before: table_set_key builds its set and holds it
-        key = table_set_key(model)
-        try:
-            object.__setattr__(model, KEY_ATTR, key)
-        except AttributeError:  # pragma: no cover - a model without a __dict__
-            pass
+    key = kept_key(model, lambda: table_set_key(model))  # a model not seen before: its set is built and held
     return _SETS.get(key, lambda: _built(model, fmt))
 
 
@@ -254,4 +222,4 @@ def unpack(data: bytes) -> tuple[dict[str, Any], list[np.ndarray]]:
 
 
 __all__ = ["Texture", "TableSet", "FIRST_UNIT", "FORMATS", "format_of", "rgl_tables", "utia_tables", "table_set",
-           "table_set_key", "Held", "read_only", "header", "pack", "unpack"]
+           "table_set_key", "kept_key", "Held", "read_only", "header", "pack", "unpack"]
