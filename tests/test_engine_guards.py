@@ -170,3 +170,29 @@ def test_compiler_lock_is_none_where_numba_lacks_it(monkeypatch):
     assert llvm_options.compiler_lock() is cl.global_compiler_lock
     monkeypatch.delattr(cl, "global_compiler_lock")
     assert llvm_options.compiler_lock() is None
+
+
+def test_ctrl_c_during_a_compile_waits_for_it_then_interrupts():
+    """``sigint_deferred`` (every driver call that may compile runs in it): a SIGINT meanwhile does not
+    interrupt the compile (a KeyboardInterrupt inside llvmlite's callbacks left LLVM broken and the
+    process died of SIGSEGV), and is delivered, as a KeyboardInterrupt, when the compile is over."""
+    import os
+    import signal
+
+    from brdfkit.engine.llvm_options import sigint_deferred
+
+    before = signal.signal(signal.SIGINT, signal.default_int_handler)  # an xdist worker may ignore SIGINT
+    try:
+        reached = []
+        with pytest.raises(KeyboardInterrupt):
+            with sigint_deferred():
+                os.kill(os.getpid(), signal.SIGINT)
+                for _ in range(1000):  # bytecode boundaries at which Python would run a handler
+                    pass
+                reached.append("the end of the compile")
+        assert reached == ["the end of the compile"]
+        assert signal.getsignal(signal.SIGINT) is signal.default_int_handler  # the handler is back
+        with sigint_deferred():  # no signal: nothing raised
+            pass
+    finally:
+        signal.signal(signal.SIGINT, before)

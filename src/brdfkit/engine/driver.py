@@ -35,7 +35,7 @@ from .cost import _PAIR_COST, PARALLEL_MIN_S  # noqa: F401  (kept importable fro
 from .generated import (_DRIVERS, _SERIAL, _span_key, _special_key, _stem, driver_for,  # noqa: F401
                         elementwise_driver_for, span_driver_for, special_driver_for)
 from .llvm_options import (F32_VECTOR_WIDTH, LLVM_UNROLL_THRESHOLD, SPAN_UNROLL_THRESHOLD, SPAN_VECTOR_WIDTH,  # noqa: F401
-                           SPECIAL_INTERLEAVE, compile_options, on_avx512)
+                           SPECIAL_INTERLEAVE, compile_options, on_avx512, sigint_deferred)
 from .precision import fits_float32
 from .templates import CHUNK, SOA_TEMPLATE, SPAN_TEMPLATE, SPECIAL_TEMPLATE, TEMPLATE  # noqa: F401
 from .threads import THREAD_SAFE_LAYERS, THREADING_LAYER
@@ -62,6 +62,15 @@ def _compile_key(drive: Callable, pt: tuple, *arrays: np.ndarray) -> tuple:
 def _first_call_options(first: bool, width: int = 0, unroll: int = LLVM_UNROLL_THRESHOLD, interleave: int = 0):
     """LLVM's options for a call that may compile (:func:`.llvm_options.compile_options`), else nothing."""
     return compile_options(width, unroll, interleave) if first else _NO_OPTIONS
+
+
+def may_compile(ck: tuple):
+    """For a call without LLVM options that may compile (its :func:`_compile_key` not yet seen): Ctrl-C
+    held until it returns (:func:`.llvm_options.sigint_deferred`), and the key noted; else nothing."""
+    if ck in _COMPILED:
+        return _NO_OPTIONS
+    _COMPILED.add(ck)  # noted first: a call that raises is not retried with the signal held again
+    return sigint_deferred()
 
 
 def nchunks(n: int) -> int:
@@ -202,12 +211,12 @@ def run(kernel: Callable, wi: np.ndarray, wo: np.ndarray, p: np.ndarray, c: np.n
         p = read_only(p.astype(np.float32))
     if n <= CHUNK:  # a single chunk runs inline, no thread pool: no lock needed
         gd = driver_for(kernel, f32)._drive
-        with vecmath.compiling():  # a compile meanwhile calls libmvec (.vecmath)
-            gd(wi, wo, p, c, out, lim, nrm)
+        with may_compile(_compile_key(gd, p, wi, wo)), vecmath.compiling():
+            gd(wi, wo, p, c, out, lim, nrm)  # a compile meanwhile calls libmvec (.vecmath)
         return nrm
     if len(p) > MAX_TUPLE:  # a table in p (measured data): the generic driver, p stays an array
         gd = driver_for(kernel, f32)._drive
-        with _RUN_LOCK, vecmath.compiling():
+        with _RUN_LOCK, may_compile(_compile_key(gd, p, wi, wo)), vecmath.compiling():
             gd(wi, wo, p, c, out, lim, nrm)
         return nrm
     choices = tuple(int(v) for v in c)

@@ -377,13 +377,14 @@ def _eval_directional(model, kernel, p, c, fi, fo, shape, f32: bool, dirs, n: in
 
 
 def _run(drive, wi, wo, pt, out, gout, lim, lo2, hi2, bad, npairs) -> None:
-    """The parallel driver, or its serial twin for a single chunk (no thread-pool launch)."""
+    """The parallel driver, or its serial twin for a single chunk (no thread-pool launch); Ctrl-C during its
+    first call, which compiles it and its twin, waits for the compile (:func:`.driver.may_compile`)."""
     import sys
 
     from . import vecmath
     if npairs <= _driver.CHUNK:
         drive = getattr(sys.modules[drive.py_func.__module__], "drive_serial", drive)
-    with vecmath.compiling():
+    with _driver.may_compile(_driver._compile_key(drive, pt, wi, wo)), vecmath.compiling():
         drive(wi, wo, pt, out, gout, lim, lo2, hi2, bad)
 
 

@@ -15,6 +15,8 @@ with LLVM's defaults instead — the same values, only slower — after one :cla
 from __future__ import annotations
 
 import contextlib
+import signal
+import threading
 
 from . import vecmath
 from .llvm_remarks import without_llvm_remarks
@@ -105,6 +107,31 @@ def _restore() -> None:
 
 
 @contextlib.contextmanager
+def sigint_deferred():
+    """Ctrl-C while a driver compiles: held until the compile is over, then delivered (to the handler
+    that was in place). numba compiles through llvmlite, which calls back into Python (its object
+    cache); a KeyboardInterrupt raised in such a ctypes callback is printed and dropped by ctypes,
+    and LLVM goes on with a broken buffer: a batch interrupted mid-compile died of SIGSEGV
+    (tests/test_measured_batch.py, the interrupt test, in a fresh-clone CI run). Only the main
+    thread receives signals; elsewhere, nothing to do."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    got: list[int] = []
+    try:
+        old = signal.signal(signal.SIGINT, lambda signum, frame: got.append(signum))
+    except ValueError:  # pragma: no cover - not the main interpreter
+        yield
+        return
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, old)
+        if got:
+            signal.raise_signal(signal.SIGINT)
+
+
+@contextlib.contextmanager
 def compile_options(width: int = 0, unroll: int = LLVM_UNROLL_THRESHOLD, interleave: int = 0):
     """LLVM's options for a driver call that may compile: ``-force-vector-width`` and
     ``-force-vector-interleave`` (0: the cost model's choice) and ``-unroll-threshold``. They are process-wide,
@@ -115,14 +142,15 @@ def compile_options(width: int = 0, unroll: int = LLVM_UNROLL_THRESHOLD, interle
     the serial and parallel HTSG span drivers then vectorised differently and differed in the last bit in
     full test runs.) The call runs under the lock too (a driver compiles on its first call); only first
     calls come here. Without the lock, or with an option refused: the call runs with LLVM's defaults
-    (module docstring)."""
+    (module docstring). Ctrl-C meanwhile waits for the compile (:func:`sigint_deferred`)."""
     lock = None if _off else compiler_lock()
     if lock is None:
         if _off is None:
             _turn_off("numba.core.compiler_lock.global_compiler_lock not found")
-        yield
+        with sigint_deferred():
+            yield
         return
-    with lock:
+    with sigint_deferred(), lock:
         if not _set_all(width, unroll, interleave):
             yield
             return
@@ -134,4 +162,4 @@ def compile_options(width: int = 0, unroll: int = LLVM_UNROLL_THRESHOLD, interle
 
 
 __all__ = ["F32_VECTOR_WIDTH", "SPECIAL_INTERLEAVE", "SPAN_UNROLL_THRESHOLD", "LLVM_UNROLL_THRESHOLD",
-           "SPAN_VECTOR_WIDTH", "compile_options", "compiler_lock", "on_avx512", "set_option"]
+           "SPAN_VECTOR_WIDTH", "compile_options", "compiler_lock", "sigint_deferred", "on_avx512", "set_option"]
