@@ -443,3 +443,52 @@ def test_non_unit_directions_are_refused_by_the_gradient_driver(dtype, n):
     ok[n // 2] /= 1.01
     ok[0] *= 1.0 + 0.5 * (1e-3 if dtype == np.float32 else 1e-4)
     m.eval_grad(wi[:-1], ok[:-1], wrt="alpha")
+
+
+# ---------------------------------------------------------------------------- the twins' analysis, kept on disk
+
+_MANIFEST_SCRIPT = r"""
+import json, sys
+import numpy as np
+import brdfkit as bk
+from brdfkit.engine import forward, grad
+
+mode, out = sys.argv[1], sys.argv[2]
+m = bk.model("phong", kd=(0.2, 0.3, 0.4), ks=0.5, shininess=30.0)
+kernel = type(m).kernel
+seeds = tuple(range(sum(s for _, _, s in grad.layout(m))))
+stem = forward._stem(kernel.py_func, (forward.EMPTY,) * 6 + (forward.P_ARRAY, forward.EMPTY), frozenset(seeds), None)
+path = forward._manifest_path(stem)
+if mode == "corrupt":
+    path.write_text("{")
+if mode == "no-analysis":
+    def refuse(self):
+        raise AssertionError("the source was analysed again")
+    forward._Func.analyse = refuse
+rng = np.random.default_rng(3)
+wi = rng.normal(size=(64, 3)); wi[:, 2] = np.abs(wi[:, 2]); wi /= np.linalg.norm(wi, axis=1)[:, None]
+wo = rng.normal(size=(64, 3)); wo[:, 2] = np.abs(wo[:, 2]); wo /= np.linalg.norm(wo, axis=1)[:, None]
+f, g = m.eval_grad(wi, wo)
+json.loads(path.read_text())  # a valid manifest is on disk afterwards
+np.save(out, np.concatenate([f.ravel()] + [g[k].ravel() for k in sorted(g)]))
+"""
+
+
+def test_a_new_process_loads_the_twin_without_analysing_its_source(tmp_path):
+    """The analysis of a kernel's sources (~0.1 s for microfacet) is kept beside the generated files: a
+    new process loads the twins from it (here: with the analysis made to fail), and a damaged manifest
+    is analysed again and rewritten, with the same values either way."""
+    import subprocess
+    import sys
+
+    script = tmp_path / "s.py"
+    script.write_text(_MANIFEST_SCRIPT)
+    got = {}
+    for mode in ("first", "no-analysis", "corrupt", "no-analysis"):
+        out = tmp_path / f"{mode}.npy"
+        r = subprocess.run([sys.executable, str(script), mode, str(out)], capture_output=True, text=True, timeout=300)
+        assert r.returncode == 0, r.stderr[-2000:]
+        got[mode] = np.load(out)
+    assert np.abs(got["first"]).max() > 0
+    for mode in ("no-analysis", "corrupt"):
+        np.testing.assert_array_equal(got[mode], got["first"])

@@ -259,6 +259,31 @@ def test_material_list():
     assert bk.material("gold-metallic-paint").material == "merl/gold-metallic-paint"
 
 
+def test_naming_a_material_reads_the_index_not_the_networks(tmp_path, monkeypatch):
+    """The material list comes from the weights file's index; a network is read when a model is built,
+    read-only and shape-checked: a file whose network has the wrong shape is a one-line ValueError."""
+    from brdfkit.measured import nbrdf
+
+    full = nbrdf.layers("merl/chrome")
+    assert [a.shape for a in full] == [(6, 21), (21,), (21, 21), (21,), (21, 3), (3,)]
+    assert all(a.dtype == np.float32 and not a.flags.writeable for a in full)
+    bad = {f"merl/x/{k}": np.zeros((2, 2), np.float32) for k in nbrdf.LAYERS}
+    path = tmp_path / "w.npz"
+    np.savez(path, **bad)
+    monkeypatch.setattr(nbrdf, "_DATA", str(path))
+    for cached in (nbrdf._entries, nbrdf.materials, nbrdf.layers):
+        cached.cache_clear()
+    try:
+        assert nbrdf.materials() == ("merl/x",)
+        with pytest.raises(ValueError, match=r"merl/x: unexpected network shape \[\(2, 2\)"):
+            bk.material("merl/x")
+    finally:
+        monkeypatch.undo()
+        for cached in (nbrdf._entries, nbrdf.materials, nbrdf.layers):
+            cached.cache_clear()
+    assert len(nbrdf.materials()) == 159
+
+
 def test_nbrdf_matches_readme_formula():
     path = os.path.join(os.path.dirname(M.__file__), "data", "nbrdf_weights.npz")
     z = np.load(path)

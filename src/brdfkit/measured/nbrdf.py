@@ -37,16 +37,36 @@ _DATA = os.path.join(os.path.dirname(__file__), "data", "nbrdf_weights.npz")
 SETS = ("merl", "rgl", "nielsen")
 
 
+#: the six arrays of one network, in the order of the flat weight vector
+LAYERS = ("fc1", "b1", "fc2", "b2", "fc3", "b3")
+
+
 @functools.lru_cache(maxsize=1)
-def _weights() -> dict[str, np.ndarray]:
+def _entries() -> tuple[str, ...]:
+    """The array names in the weights file, read from its index alone (naming a material
+    must not inflate 954 arrays: that was 0.1 s of every fresh ``brdfkit fit merl/…``)."""
     with np.load(_DATA) as z:
-        return {k: z[k].astype(np.float32) for k in z.files}
+        return tuple(z.files)
+
+
+@functools.lru_cache(maxsize=8)
+def layers(full: str) -> tuple[np.ndarray, ...]:
+    """The network of the material ``full`` (``set/name``): its :data:`LAYERS`, float32, shapes
+    checked (``ValueError`` names the shape found)."""
+    with np.load(_DATA) as z:
+        out = tuple(z[f"{full}/{k}"].astype(np.float32) for k in LAYERS)
+    shapes = ((N_IN, N_HID), (N_HID,), (N_HID, N_HID), (N_HID,), (N_HID, N_OUT), (N_OUT,))
+    if tuple(a.shape for a in out) != shapes:
+        raise ValueError(f"{full}: unexpected network shape {[a.shape for a in out]}")
+    for a in out:
+        a.flags.writeable = False
+    return out
 
 
 @functools.lru_cache(maxsize=1)
 def materials() -> tuple[str, ...]:
     """Names of every built-in measured material (``set/name``), sorted by set then name."""
-    names = {k.rsplit("/", 1)[0] for k in _weights()}
+    names = {k.rsplit("/", 1)[0] for k in _entries()}
     return tuple(sorted(names, key=lambda n: (SETS.index(n.split("/")[0]) if n.split("/")[0] in SETS else 9, n)))
 
 
@@ -157,13 +177,9 @@ class NeuralBRDF(MeasuredBRDF):
 
     def __init__(self, material: str) -> None:
         full = resolve(material)
-        w = _weights()
         self.material = full
         self.label = full
-        self._layers = tuple(w[f"{full}/{k}"] for k in ("fc1", "b1", "fc2", "b2", "fc3", "b3"))
-        shapes = ((N_IN, N_HID), (N_HID,), (N_HID, N_HID), (N_HID,), (N_HID, N_OUT), (N_OUT,))
-        if tuple(a.shape for a in self._layers) != shapes:
-            raise ValueError(f"{full}: unexpected network shape {[a.shape for a in self._layers]}")
+        self._layers = layers(full)
         self._flat = np.ascontiguousarray(np.concatenate([a.astype(np.float64).ravel() for a in self._layers]))
         super().__init__()
 

@@ -209,13 +209,7 @@ def nbrdf_weights(name: str) -> np.ndarray:
     """The network of a built-in material as the 844 float32 values ``nbrdf.glsl`` reads."""
     from ..measured import nbrdf
 
-    full = nbrdf.resolve(name)
-    w = nbrdf._weights()
-    layers = [w[f"{full}/{k}"] for k in ("fc1", "b1", "fc2", "b2", "fc3", "b3")]
-    shapes = [(N_IN, 21), (21,), (21, 21), (21,), (21, 3), (3,)]
-    if [tuple(a.shape) for a in layers] != shapes:
-        raise ValueError(f"{full}: unexpected network shape {[a.shape for a in layers]}")
-    return nbrdf_blocks(*layers)
+    return nbrdf_blocks(*nbrdf.layers(nbrdf.resolve(name)))
 
 
 @route("GET", "/api/nbrdf")
