@@ -492,3 +492,35 @@ def test_a_new_process_loads_the_twin_without_analysing_its_source(tmp_path):
     assert np.abs(got["first"]).max() > 0
     for mode in ("no-analysis", "corrupt"):
         np.testing.assert_array_equal(got[mode], got["first"])
+
+
+@pytest.mark.parametrize("eng", ["compiled", "reference"])
+def test_schlick_tiny_isotropy_has_no_nan_derivative(eng):
+    """Schlick's ∂f/∂p for p down to the smallest float: never NaN (it was inf/inf below p ≈ 1e-300, an
+    intermediate ``d(hx/√p)/dp`` beyond the float range); equal to relative-step differences where it is
+    finite (w ≠ 0: dA/dp ≈ A/(2p)), and at w = 0 (hx = 0, A = 1/√p) the true −f/(2p), which is beyond
+    the float range (−inf) once p < 1e-205."""
+    rng = np.random.default_rng(4)
+    wi, wo = random_unit_vectors(200, rng), random_unit_vectors(200, rng)
+    wi[:, 2], wo[:, 2] = np.abs(wi[:, 2]), np.abs(wo[:, 2])
+    wi[:4, 0] = wo[:4, 0] = 0.0  # h in the y-z plane: w = 0
+    wi /= np.linalg.norm(wi, axis=1, keepdims=True)
+    wo /= np.linalg.norm(wo, axis=1, keepdims=True)
+    for p in (5e-324, 1e-320, 1e-300, 1e-250, 1e-200, 1e-30):
+        m = bk.model("schlick", p=p, r=0.05)
+        f, g = _with_engine(eng, lambda: m.eval_grad(wi, wo))
+        d = g["p"]
+        assert not np.isnan(d).any(), p
+        assert np.isfinite(d[4:]).all(), p
+        if p >= 1e-200:
+            w0 = -f[:4] / (2 * p)  # d(1/√p)/dp · f·√p
+            np.testing.assert_allclose(d[:4], w0, rtol=1e-12)
+        else:
+            assert (d[:4] == -np.inf).all()
+        if p >= 1e-300:
+            e = 1e-6
+            up = _with_engine(eng, lambda: bk.model("schlick", p=p * (1 + e), r=0.05).eval(wi, wo))
+            dn = _with_engine(eng, lambda: bk.model("schlick", p=p * (1 - e), r=0.05).eval(wi, wo))
+            with np.errstate(over="ignore"):  # w = 0: beyond the float range, compared above
+                fd = (up - dn) / (2 * p * e)
+            np.testing.assert_allclose(d[4:], fd[4:], rtol=1e-6, atol=1e-9 * np.abs(fd[4:]).max())

@@ -18,7 +18,8 @@ by pair in Python float64 under the reference engine. Two compiled routes:
 
 ``grads[name]`` has shape ``(..., 3)`` for a scalar parameter and ``(..., 3, 3)`` for an RGB one,
 ``[..., channel_out, channel_in]`` (SPEC.md, "Gradients"). Below the horizon, and where ``f`` is
-clamped to the dtype's largest value, the derivatives are 0. At a kink (``min``/``max``/clamp, a
+clamped to the dtype's largest value, the derivatives are 0; a derivative whose exact value is
+beyond the float range is ±inf (schlick's ∂f/∂p at w = 0 for p < 1e-205: −f/(2p)), never NaN. At a kink (``min``/``max``/clamp, a
 branch) the derivative is the one of the branch the code takes (:mod:`.forward`).
 """
 

@@ -102,8 +102,10 @@ hx² + hy², so no cancellation for t → 1), the glossy part is evaluated as
 ``(1 − r)/π · A · (q/d)(q/d')`` — the same as b·Z·A·G G'/(4π v v') since
 b·Z = 4(1 − r) q² — so neither Z = 1/r (at h = n) nor r² is ever formed; q ≤ 2
 everywhere. (Before this guard r = 1e-170 gave Inf, and float32 failed from
-r ≈ 1e-19.) A is evaluated as ``hypot(hx, hy)/hypot(√p·hy, hx/√p)``, which
-never squares p (1/sqrt(p) at w = 0 for tiny p instead of p/0); at h = n w is
+r ≈ 1e-19.) A is evaluated as ``hypot(hx, hy)·√p/hypot(p·hy, hx)``, and where that
+denominator is below the smallest normal number (w ≈ 0, tiny p) as
+``hypot(hx, hy)/hypot(√p·hy, hx/√p)``, which never multiplies p into a subnormal (1/sqrt(p)
+at w = 0 for tiny p instead of p/0; :func:`azimuth_factor`); at h = n w is
 undefined and A is taken as 1. d and d' are floored at 1e-300 (which only
 matters when r and v are both below it), and each slab's directional factor is
 capped at 1e300 (:data:`SLAB_CAP`): a near-mirror slab (r → 0) lit and seen at
@@ -138,7 +140,7 @@ import math
 import numpy as np
 
 from ..engine import jit
-from ..geometry import dot3, half_vector_c, hypot_c
+from ..geometry import NORMAL_MIN, dot3, half_vector_c, hypot_c
 from ..params import Param
 from ..registry import register
 from ..terms.fresnel import f_schlick, fresnel_schlick
@@ -176,17 +178,25 @@ def zenith_ratio(t, s2, r):
 def azimuth_factor(hx, hy, p):
     """Schlick's A(w) = sqrt(p/(p² − p² w² + w²)), w = hx/sqrt(hx² + hy²), 1 at h = n.
 
-    Evaluated as ``hypot(hx, hy)/hypot(sqrt(p)·hy, hx/sqrt(p))`` (the same expression, since
-    p²(1 − w²) + w² = ((p hy)² + hx²)/(hx² + hy²)): p is never squared nor multiplied into a
-    subnormal, so p down to the smallest positive float gives the finite 1/sqrt(p) at w = 0
-    instead of p/0, to full precision.
+    Since p²(1 − w²) + w² = ((p hy)² + hx²)/(hx² + hy²), A = ``hypot(hx, hy)·√p / hypot(p·hy, hx)``:
+    evaluated so wherever that denominator is a normal number (then a subnormal ``p·hy`` adds at
+    most 1e-16 of it). Otherwise (hx and p·hy both below the smallest normal number: w ≈ 0 with a
+    tiny p) as ``hypot(hx, hy)/hypot(√p·hy, hx/√p)``, the same expression with p never multiplied
+    into a subnormal, so p down to the smallest positive float gives the finite 1/√p at w = 0, to
+    full precision. The first form is also the one whose derivative in p (``eval_grad``) has no
+    intermediate beyond the float range: the second's ``d(hx/√p)/dp = −hx/(2 p^1.5)`` overflows for
+    p < 1e-200 where dA/dp ≈ A/(2p) does not, and gave NaN (inf/inf).
     """
     if p == 1.0:
         return 1.0
     sp = math.sqrt(p)
+    h = hypot_c(hx, hy)
+    d1 = hypot_c(p * hy, hx)
+    if d1 >= NORMAL_MIN:
+        return h * sp / d1
     den = hypot_c(sp * hy, hx / sp)
     # den = 0 only at hx = hy = 0 (h = n): A is undefined there, take 1 (a select, no branch)
-    a = hypot_c(hx, hy) / (den if den != 0.0 else 1.0)
+    a = h / (den if den != 0.0 else 1.0)
     return a if den != 0.0 else 1.0
 
 
