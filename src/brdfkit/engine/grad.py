@@ -315,7 +315,8 @@ def eval_grad(model, wi, wo, wrt=None):
                 lo2, hi2 = _driver.unit_band(out.dtype, np.float64)
                 _run(drive, w_i.astype(np.float64), w_o.astype(np.float64), pt, o64, g64, lim, lo2, hi2, bad, npairs)
                 out[...] = np.minimum(o64, lim)
-                gout[...] = np.where(o64[..., None] < lim, g64, 0.0)
+                with np.errstate(over="ignore"):  # a derivative beyond float32's range is ±inf (module docstring)
+                    gout[...] = np.where(o64[..., None] < lim, g64, 0.0)
             else:
                 lo2, hi2 = _driver.unit_band(out.dtype, ft)
                 _run(drive, w_i, w_o, pt, out, gout, ft(lim), lo2, hi2, bad, npairs)
