@@ -2,6 +2,7 @@
 
     .venv/bin/python benchmarks/bench_vs_mitsuba.py                  # table with the ratios
     .venv/bin/python benchmarks/bench_vs_mitsuba.py --rounds 7 --log2n 20 --json
+    .venv/bin/python benchmarks/bench_vs_mitsuba.py --grad             # derivatives: Dr.Jit AD vs eval_grad
 
 The same BRDF on both sides: GGX (width alpha), the separable Smith shadowing
 G1(wi)·G1(wo), conductor Fresnel, no diffuse part — brdfkit's
@@ -33,6 +34,15 @@ single calls of all rounds, the figure least disturbed by other jobs on a shared
 spread between a side's median and fastest call can differ between the two sides). On a shared
 machine read the ratios, taken side by side, rather than
 the absolute rates.
+
+``--grad`` (issue 31, the choice between its two routes to gradients: brdfkit's forward twins of the
+scalar source, or Dr.Jit's automatic differentiation): per-pair derivatives of the same BRDF, float32,
+in alternating processes. Mitsuba: ``bsdf.eval`` and, per derivative, one ``dr.forward`` pass from the
+parameter (``alpha``; ``eta`` and ``k`` as RGB colours, whose channel ``c`` reaches only ``f_c``, so one
+pass each gives the three ``∂f_c/∂eta_c``), numpy in and numpy out on both sides, Dr.Jit's kernels
+cached after the warm-up calls. brdfkit: ``m.eval``, ``m.eval_grad(wrt="alpha")``, ``wrt="eta"`` and
+``wrt=["alpha", "eta", "k"]`` (the seven derivatives). It prints each side's rates, its
+gradient/eval ratio, and brdfkit's gradient rate over Mitsuba's for the same derivatives.
 
 Dr.Jit (1.5, with Mitsuba 3.9) emits LLVM's ``fmaximum``, which LLVM 14/15 — Debian 12's
 default ``libLLVM`` — cannot compile ("LLVM ERROR: Cannot select: fmaximum"); the script
@@ -151,7 +161,117 @@ def worker_brdfkit(n: int, calls: int, threads: int = 0) -> dict:
     return out
 
 
+def worker_mitsuba_grad(n: int, calls: int, threads: int = 0) -> dict:
+    """Mitsuba's eval and its forward-mode derivatives (``--grad``), numpy in and out."""
+    import drjit as dr
+    import mitsuba as mi
+
+    if threads:
+        dr.set_thread_count(threads)
+    mi.set_variant("llvm_ad_rgb")
+    bsdf = mi.load_dict({"type": "roughconductor", "distribution": "ggx", "alpha": ALPHA,
+                         "eta": {"type": "rgb", "value": list(ETA)}, "k": {"type": "rgb", "value": list(K)}})
+    params = mi.traverse(bsdf)
+    keys = ("alpha.value", "eta.value", "k.value")
+    wi, wo = directions(n)
+    wi32, wo32 = wi.astype(np.float32), wo.astype(np.float32)
+    ctx = mi.BSDFContext()
+
+    def to_dr(a):
+        return mi.Vector3f(a[:, 0], a[:, 1], a[:, 2])
+
+    def evaluate():
+        s = dr.zeros(mi.SurfaceInteraction3f, n)
+        s.wi = to_dr(wo32)
+        return bsdf.eval(ctx, s, to_dr(wi32))
+
+    def value():
+        return np.array(evaluate())
+
+    def grads(which):
+        out = []
+        for key in which:
+            dr.enable_grad(params[key])
+            params.update()
+            v = evaluate()
+            dr.forward(params[key])
+            out.append(np.array(dr.grad(v)))
+            dr.disable_grad(params[key])
+            params.update()
+        return np.array(v), out
+
+    t_eval, b_eval = _times(value, calls)
+    t_one, b_one = _times(lambda: grads(keys[:1]), calls)
+    t_rgb, b_rgb = _times(lambda: grads(keys[1:2]), calls)
+    t_all, b_all = _times(lambda: grads(keys), calls)
+    _, (g,) = grads(keys[:1])
+    g = np.asarray(g)
+    if g.shape[0] == 3 and g.shape[-1] != 3:
+        g = g.T
+    return {"eval_s": t_eval, "one_s": t_one, "rgb_s": t_rgb, "all_s": t_all, "eval_best_s": b_eval,
+            "one_best_s": b_one, "rgb_best_s": b_rgb, "all_best_s": b_all, "sample": (g / wi32[:, 2:3])[:4096].astype(np.float64).tolist()}
+
+
+def worker_brdfkit_grad(n: int, calls: int, threads: int = 0) -> dict:
+    """brdfkit's eval and eval_grad of the same BRDF (``--grad``), float32."""
+    import brdfkit as bk
+    from brdfkit import engine
+
+    engine.set_engine("compiled")
+    m = bk.model("microfacet", distribution="ggx", shadowing="smith", fresnel="conductor",
+                 alpha=ALPHA, eta=ETA, k=K, kd=0.0, ks=1.0)
+    wi, wo = (w.astype(np.float32) for w in directions(n))
+    out = {}
+    for name, fn in (("eval", lambda: m.eval(wi, wo)), ("one", lambda: m.eval_grad(wi, wo, wrt="alpha")),
+                     ("rgb", lambda: m.eval_grad(wi, wo, wrt="eta")),
+                     ("all", lambda: m.eval_grad(wi, wo, wrt=["alpha", "eta", "k"]))):
+        out[name + "_s"], out[name + "_best_s"] = _times(fn, calls)
+    out["sample"] = m.eval_grad(wi, wo, wrt="alpha")[1]["alpha"][:4096].astype(np.float64).tolist()
+    return out
+
+
+def grad_main(args, n: int) -> int:
+    """``--grad``: the two routes to per-pair derivatives, side by side (module docstring)."""
+    mits, bks = [], []
+    for _ in range(args.rounds):
+        mits.append(_run_worker("mitsuba-grad", n, args.calls, args.threads))
+        bks.append(_run_worker("brdfkit-grad", n, args.calls, args.threads))
+    med = statistics.median
+    rate = lambda t: n / t / 1e6  # noqa: E731
+    a, b = np.array(mits[0]["sample"]), np.array(bks[0]["sample"])
+    ok = np.abs(b) > 1e-3 * np.abs(b).max()
+    res = {"pairs": n, "rounds": args.rounds, "threads": args.threads or "all",
+           "load_average": os.getloadavg()[0] if hasattr(os, "getloadavg") else None,
+           "median_rel_difference_dalpha": float(np.median(np.abs(a[ok] - b[ok]) / np.abs(b[ok])))}
+    for side, rows in (("mitsuba", mits), ("brdfkit", bks)):
+        for k in ("eval", "one", "rgb", "all"):
+            res[f"{side}_{k}_M_s"] = rate(med(r[k + "_s"] for r in rows))
+            res[f"{side}_{k}_fastest_M_s"] = rate(min(r[k + "_best_s"] for r in rows))
+    if args.json:
+        print(json.dumps(res, indent=2))
+        return 0
+    print(f"GGX conductor float32, {n} pairs, per-pair derivatives, {args.rounds} alternating process rounds x "
+          f"{args.calls} calls (load average {res['load_average']:.2f}, threads: {res['threads']}); M pairs/s, "
+          f"median (fastest call)")
+    print(f"{'':34}{'mitsuba (Dr.Jit AD)':>24}{'brdfkit (forward twin)':>26}{'brdfkit / mitsuba':>20}")
+    for k, label in (("eval", "eval"), ("one", "d/d alpha"), ("rgb", "d/d eta (3 values)"),
+                     ("all", "d/d alpha, eta, k (7 values)")):
+        m_, b_ = res[f"mitsuba_{k}_M_s"], res[f"brdfkit_{k}_M_s"]
+        mf, bf = res[f"mitsuba_{k}_fastest_M_s"], res[f"brdfkit_{k}_fastest_M_s"]
+        print(f"{label:<34}{m_:>13.1f} ({mf:7.1f}){b_:>15.1f} ({bf:7.1f}){b_ / m_:>12.2f}x ({bf / mf:.2f}x)")
+    for side in ("mitsuba", "brdfkit"):
+        e = res[f"{side}_eval_M_s"]
+        print(f"  {side}: gradient / eval throughput: d/d alpha {res[f'{side}_one_M_s'] / e:.3f}, "
+              f"d/d eta {res[f'{side}_rgb_M_s'] / e:.3f}, all seven {res[f'{side}_all_M_s'] / e:.3f}")
+    print(f"  d/d alpha agrees to a median relative difference of {res['median_rel_difference_dalpha']:.2g} "
+          f"(Mitsuba's Fresnel form differs slightly)")
+    return 0
+
+
 # --------------------------------------------------------------------------- driver
+WORKERS = {"mitsuba": worker_mitsuba, "brdfkit": worker_brdfkit, "mitsuba-grad": worker_mitsuba_grad,
+           "brdfkit-grad": worker_brdfkit_grad}
+
 #: the oldest LLVM that compiles the ``fmaximum`` Dr.Jit 1.5 emits
 MIN_LLVM = 16
 
@@ -177,7 +297,7 @@ def _run_worker(kind: str, n: int, calls: int, threads: int = 0) -> dict:
     env = dict(os.environ)
     if threads:
         env["NUMBA_NUM_THREADS"] = str(threads)  # numba's pool is sized at import, in the worker
-    if kind == "mitsuba" and "DRJIT_LIBLLVM_PATH" not in env:
+    if kind.startswith("mitsuba") and "DRJIT_LIBLLVM_PATH" not in env:
         lib, version = newest_libllvm()
         if version < MIN_LLVM:  # Dr.Jit would abort inside LLVM with a page of "Cannot select" output
             raise SystemExit(f"bench_vs_mitsuba: Mitsuba's LLVM variant needs libLLVM >= {MIN_LLVM}, the newest here is "
@@ -197,13 +317,15 @@ def main(argv=None) -> int:
     ap.add_argument("--threads", type=int, default=0,
                     help="threads on both sides (Dr.Jit's pool, numba's); default: every core")
     ap.add_argument("--json", action="store_true")
-    ap.add_argument("--worker", choices=("mitsuba", "brdfkit"), help=argparse.SUPPRESS)
+    ap.add_argument("--grad", action="store_true", help="per-pair derivatives: Dr.Jit's AD against eval_grad")
+    ap.add_argument("--worker", choices=tuple(WORKERS), help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     n = 1 << args.log2n
     if args.worker:
-        fn = worker_mitsuba if args.worker == "mitsuba" else worker_brdfkit
-        print(json.dumps(fn(n, args.calls, args.threads)))
+        print(json.dumps(WORKERS[args.worker](n, args.calls, args.threads)))
         return 0
+    if args.grad:
+        return grad_main(args, n)
 
     mits, bks = [], []
     for _ in range(args.rounds):

@@ -380,6 +380,8 @@ def test_model_without_kernel_has_no_gradient(tmp_path):
 
 WRT_CASES = [
     ("microfacet", {"distribution": "ggx", "fresnel": "conductor", "alpha": 0.3}, "alpha"),
+    ("microfacet", {"distribution": "ggx", "fresnel": "conductor", "alpha": 0.3}, ["eta", "alpha"]),
+    ("oren-nayar", {"kd": (0.2, 0.5, 0.7), "sigma": 0.4}, "kd"),
     ("microfacet", {"distribution": "beckmann", "fresnel": "conductor", "alpha": 0.2}, ["eta", "kd"]),
     ("ward", {"alpha_x": 0.2, "alpha_y": 0.4}, ("alpha_y",)),
     ("phong", {"kd": (0.2, 0.3, 0.4), "ks": 0.5, "shininess": 30.0}, ["shininess", "ks"]),
@@ -390,7 +392,8 @@ WRT_CASES = [
 @pytest.mark.parametrize("name,params,wrt", WRT_CASES)
 def test_wrt_gives_the_same_derivatives_as_all(eng, dtype, name, params, wrt, monkeypatch):
     """A few names go through the directional driver (one vectorised pass per derivative, at most
-    ``DIRECTIONAL_MAX``), more through a twin seeded by just those: either way the values are the full
+    ``DIRECTIONAL_MAX``; an RGB parameter's three in one pass, column compression), more through a twin
+    seeded by just those: either way the values are the full
     gradient's to the last bit (float64; float32, where LLVM may also fuse multiply-adds differently: a few ulps)
     and the derivatives agree to rounding (a direction e_x + e_y sums the two tangents inside the
     computation; float64 1e-12 of the largest magnitude, float32, whose derivatives carry
@@ -524,3 +527,48 @@ def test_schlick_tiny_isotropy_has_no_nan_derivative(eng):
             with np.errstate(over="ignore"):  # w = 0: beyond the float range, compared above
                 fd = (up - dn) / (2 * p * e)
             np.testing.assert_allclose(d[4:], fd[4:], rtol=1e-6, atol=1e-9 * np.abs(fd[4:]).max())
+
+
+def test_passes_share_a_pass_only_between_disjoint_channels():
+    """Column compression: derivatives share a directional pass only where the channels they can reach are
+    disjoint; one that reaches none is in no pass."""
+    from brdfkit.engine.grad import passes
+
+    e = np.eye(6)
+    dirs = [("s", None, e[0]), ("c", 0, e[1]), ("c", 1, e[2]), ("c", 2, e[3]), ("d", 0, e[4]), ("z", None, e[5])]
+    reach = (frozenset({0, 1, 4}), frozenset({0, 2}), frozenset({0, 3}))  # p[0] everywhere, p[5] nowhere
+    groups, touched = passes(dirs, reach)
+    assert touched == [frozenset({0, 1, 2}), frozenset({0}), frozenset({1}), frozenset({2}), frozenset({0}), frozenset()]
+    assert groups == [[0], [1, 2, 3], [4]]
+
+
+@pytest.mark.parametrize("dtype", [np.float64, np.float32])
+@pytest.mark.parametrize("name,params,wrt", [
+    ("microfacet", {"distribution": "ggx", "fresnel": "conductor", "alpha": 0.3}, ["eta", "alpha"]),
+    ("ward", {"alpha_x": 0.2, "alpha_y": 0.4}, "kd"),
+    ("cook-torrance", {}, "ior"),
+])
+def test_compressed_passes_equal_one_pass_per_derivative(monkeypatch, dtype, name, params, wrt):
+    """An RGB parameter's three derivatives from one pass along e_r + e_g + e_b are bit for bit those of
+    three passes along e_r, e_g, e_b (each channel's tangent sums terms that are exactly 0 but one), and
+    the entries [..., c_out, c_in] with c_out != c_in are exactly 0."""
+    from brdfkit.engine import grad
+
+    m = bk.model(name, **params)
+    wi, wo = (w.astype(dtype) for w in _pairs(11, 3000))
+    f, g = m.eval_grad(wi, wo, wrt=wrt)
+    compressed = grad.passes
+
+    def one_each(dirs, reach):
+        groups, touched = compressed(dirs, reach)
+        assert any(len(gr) > 1 for gr in groups)  # the case compresses
+        return [[i] for i in range(len(dirs)) if touched[i]], touched
+
+    monkeypatch.setattr(grad, "passes", one_each)
+    f1, g1 = m.eval_grad(wi, wo, wrt=wrt)
+    np.testing.assert_array_equal(f, f1)
+    for k in g:
+        np.testing.assert_array_equal(g[k], g1[k], err_msg=k)
+        if g[k].ndim == 3:
+            assert not (g[k] * (1 - np.eye(3))).any()
+            assert np.abs(g[k]).max() > 0

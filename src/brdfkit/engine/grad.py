@@ -9,12 +9,15 @@ by pair in Python float64 under the reference engine. Two compiled routes:
   asked-for parameter component (its static sparsity kept: ``kd_r`` only reaches red); its callees
   are compiled out of line (a cold compile in seconds, not minutes), so LLVM does not vectorise the
   loop across pairs;
-* the directional twin (:data:`DIRECTIONAL_TEMPLATE`), for ``wrt`` naming at most
-  :data:`DIRECTIONAL_MAX` derivatives: ONE tangent, the derivative along a direction appended to
-  ``p`` (``e_k`` for a component, ``e_x + e_y`` for microfacet's ``alpha``), inlined into the loop of
-  ``eval``'s specialised driver, which LLVM vectorises: one pass per derivative, each ~3× an ``eval``
-  (GGX float32, benchmarks/bench_grad.py), one compiled twin per kernel and choices whatever the
-  direction.
+* the directional twin (:data:`DIRECTIONAL_TEMPLATE`): ONE tangent, the derivative along a direction
+  appended to ``p`` (``e_k`` for a component, ``e_x + e_y`` for microfacet's ``alpha``), inlined into
+  the loop of ``eval``'s specialised driver, which LLVM vectorises: each pass ~3× an ``eval`` (GGX
+  float32, benchmarks/bench_grad.py), one compiled twin per kernel and choices whatever the direction.
+  Derivatives that reach disjoint output channels share a pass (column compression, Curtis, Powell &
+  Reid 1974: ``kd_r``, ``kd_g``, ``kd_b`` along ``e_r + e_g + e_b`` give the three in one pass, since
+  red depends on ``kd_r`` alone), the channels each parameter component can reach being the
+  many-tangent twin's static sparsity pattern (:func:`passes`). Used for ``wrt`` naming at most
+  :data:`DIRECTIONAL_MAX` derivatives.
 
 ``grads[name]`` has shape ``(..., 3)`` for a scalar parameter and ``(..., 3, 3)`` for an RGB one,
 ``[..., channel_out, channel_in]`` (SPEC.md, "Gradients"). Below the horizon, and where ``f`` is
@@ -29,8 +32,11 @@ import threading
 
 import numpy as np
 
+import numba
+
 from . import driver as _driver
 from .active import engine
+from .cache import in_cache_dir
 from .evaluate import prepare
 from .forward import Unsupported, forward_kernel, _KEY_OF
 from .generated import _load
@@ -118,10 +124,13 @@ def span(wi, wo, p, out, gout, lim, lo2, hi2, nrm, ch, lo, hi):
 ''' + _DRIVES
 
 #: ``wrt`` naming at most this many derivatives (a parameter component each; microfacet's ``alpha`` one):
-#: directional passes, one vectorised pass each; more: one pass of the many-tangent driver. Measured, GGX
-#: conductor float32, 2^20 pairs, throughput as a fraction of eval's, directional / many-tangent: 1
-#: derivative 0.33 / 0.076, 2: 0.165 / 0.075, 4: 0.083 / 0.069, 7: 0.047 / 0.064, 15: 0.025 / 0.034. The
-#: default, every parameter, always takes the many-tangent pass (its f is eval's bit for bit in float64)
+#: directional passes (those reaching disjoint channels sharing one, :func:`passes`); more, or ``wrt``
+#: omitted: one pass of the many-tangent driver (its f is eval's bit for bit in float64). Measured, GGX
+#: conductor float32, 2^20 pairs, throughput as a fraction of eval's, one pass per derivative /
+#: many-tangent: 1 derivative 0.33 / 0.076, 2: 0.165 / 0.075, 4: 0.083 / 0.069, 7: 0.047 / 0.064, 15:
+#: 0.025 / 0.034. Compressed passes beyond this bound were measured too (docs/speed.md): they win for
+#: GGX conductor's ``alpha, eta, k`` (0.065 / 0.041) but lose for most other models and sets (Ward's
+#: ``kd, ks``: 0.19 / 0.28), so the bound stays on the number of derivatives
 DIRECTIONAL_MAX = 4
 
 _LOCK = threading.Lock()
@@ -239,6 +248,30 @@ def _directions(lay, names: list[str]) -> list[tuple[str, int | None, np.ndarray
     return out
 
 
+def passes(dirs, reach) -> tuple[list[list[int]], list[frozenset]]:
+    """Column compression of the derivatives ``dirs`` (:func:`_directions`): ``(groups, touched)``, with
+    ``touched[i]`` the output channels derivative ``i`` can reach (``reach[c]``: the components of ``p`` that
+    can reach channel ``c``, the many-tangent twin's return patterns) and ``groups`` lists of derivatives
+    whose channels are disjoint, each one directional pass along the sum of their directions (first fit,
+    in order). A derivative that reaches no channel is identically 0 and in no group."""
+    groups: list[tuple[set, list[int]]] = []
+    touched = []
+    for i, (_, _, v) in enumerate(dirs):
+        support = {int(k) for k in np.flatnonzero(v)}
+        t = frozenset(c for c in range(3) if support & reach[c])
+        touched.append(t)
+        if not t:
+            continue
+        for used, members in groups:
+            if not used & t:
+                used |= t
+                members.append(i)
+                break
+        else:
+            groups.append((set(t), [i]))
+    return [members for _, members in groups], touched
+
+
 def _reference(kernel, seeds, fi, fo, p, c, out, gout, lim) -> None:
     from .reference import pure
 
@@ -288,14 +321,21 @@ def eval_grad(model, wi, wo, wrt=None):
     f32 = dtype == np.float32 and getattr(type(model), "kernel_float32", True) and fits_float32(p)
     ft = np.float32 if f32 else np.float64
     if npairs and wrt is not None and engine() == "compiled" and np.dtype(dtype) == ft:
-        # a few derivatives asked for by name: one vectorised pass each (f to the last bit of eval's:
-        # the vectorised loop may call the vector math library where eval's scalar loop calls libm)
-        dirs = _directions(full, names)
-        if len(dirs) <= DIRECTIONAL_MAX:
-            try:
-                return _eval_directional(model, kernel, p, c, fi, fo, shape, f32, dirs, sum(s for _, _, s in full))
-            except Unsupported as e:
-                raise ValueError(f"{name}: no gradient ({e})") from None
+        # a few derivatives asked for by name: vectorised directional passes (f then to the last bit
+        # of eval's: the vectorised loop may call the vector math library where eval's scalar loop calls libm)
+        try:
+            total = sum(s for _, _, s in full)
+            # microfacet's alpha with both axes asked for too: their sum, no pass of its own
+            summed = "alpha" in names and {"alpha_x", "alpha_y"} <= set(names)
+            dirs = _directions(full, [k for k in names if not (summed and k == "alpha")])
+            if len(dirs) <= DIRECTIONAL_MAX:
+                groups, touched = passes(dirs, forward_kernel(kernel, total)[1])
+                f, grads = _eval_directional(model, kernel, p, c, fi, fo, shape, f32, dirs, total, groups, touched)
+                if summed:
+                    grads["alpha"] = grads["alpha_x"] + grads["alpha_y"]
+                return f, {k: grads[k] for k in names}
+        except Unsupported as e:
+            raise ValueError(f"{name}: no gradient ({e})") from None
     out = np.zeros((npairs, 3), dtype=dtype)
     gout = np.zeros((npairs, 3, n), dtype=dtype)
     lim = float(np.finfo(dtype).max)
@@ -343,38 +383,74 @@ def eval_grad(model, wi, wo, wrt=None):
     return f, {k: grads[k] for k in names}
 
 
-def _eval_directional(model, kernel, p, c, fi, fo, shape, f32: bool, dirs, n: int):
-    """``eval_grad`` by one vectorised pass per derivative (:data:`DIRECTIONAL_TEMPLATE`): ``f`` and, per
-    entry of ``dirs``, the derivative along its direction. An RGB parameter's ``(..., 3, 3)`` derivative
-    is a view of its three passes' planes."""
+def _scatter_py(planes, src, gout):
+    """``gout[j, c, k] = planes[src[c, k], j, c]`` (0 where ``src[c, k] < 0``): the directional passes'
+    planes laid out as eval_grad's ``(n, 3, derivatives)`` block, in one parallel pass over the pairs."""
+    n = gout.shape[0]
+    m = gout.shape[2]
+    zero = gout.dtype.type(0)
+    for j in numba.prange(n):
+        for c in range(3):
+            for k in range(m):
+                g = src[c, k]
+                gout[j, c, k] = planes[g, j, c] if g >= 0 else zero
+
+
+with in_cache_dir():
+    _scatter = numba.njit(parallel=True, cache=True, nogil=True, error_model="numpy")(_scatter_py)
+
+
+def _eval_directional(model, kernel, p, c, fi, fo, shape, f32: bool, dirs, n: int, groups, touched):
+    """``eval_grad`` by vectorised directional passes (:data:`DIRECTIONAL_TEMPLATE`), one per group of
+    :func:`passes`, along the sum of its derivatives' directions: ``f`` and, per entry of ``dirs``, its
+    derivative — the pass's plane in the channels it reaches (no other derivative of the group reaches
+    them), 0 in the others. An RGB parameter's derivative is ``(..., 3, 3)``, ``[..., channel_out, channel_in]``."""
     ft = np.float32 if f32 else np.float64
     npairs = fi.shape[0]
     choices = tuple(int(v) for v in c)
     p = np.asarray(p, dtype=np.float64)
     off = len(p)
-    with _LOCK:
-        drive = _directional_driver(kernel, choices, f32, n, off)
+    if groups:
+        with _LOCK:
+            drive = _directional_driver(kernel, choices, f32, n, off)
     w_i, w_o = _driver.read_only(fi).reshape(-1), _driver.read_only(fo).reshape(-1)
-    out = np.empty((npairs, 3), dtype=ft)
-    planes = np.empty((len(dirs), npairs, 3), dtype=ft)
+    out = np.zeros((npairs, 3), dtype=ft)
+    planes = np.empty((len(groups), npairs, 3), dtype=ft)
     bad = np.zeros(_driver.nchunks(npairs), dtype=np.int64)
     lo2, hi2 = _driver.unit_band(out.dtype, ft)
     lim = ft(np.finfo(ft).max)
-    for i, (_, _, v) in enumerate(dirs):
+    if not groups:  # nothing reaches f: f itself, by eval's driver
+        out[...] = np.asarray(model.eval(fi, fo), dtype=ft)
+    for g, members in enumerate(groups):
+        v = sum(dirs[i][2] for i in members)
         pt = _driver.param_tuple(np.concatenate([p, v]), ft)
-        _run(drive, w_i, w_o, pt, out.reshape(-1), planes[i].reshape(-1), lim, lo2, hi2, bad, npairs)
-        if i == 0 and bad.any():  # some length outside the safe band: the exact check
+        _run(drive, w_i, w_o, pt, out.reshape(-1), planes[g].reshape(-1), lim, lo2, hi2, bad, npairs)
+        if g == 0 and bad.any():  # some length outside the safe band: the exact check
             check_unit_flat(model.name, fi, fo, out.dtype)
-    grads = {}
-    i = 0
-    while i < len(dirs):
-        name, ch, _ = dirs[i]
-        if ch is None:
-            grads[name] = planes[i].reshape(shape)
-            i += 1
-        else:  # three passes, channel_in 0, 1, 2: [..., channel_out, channel_in]
-            grads[name] = planes[i:i + 3].transpose(1, 2, 0).reshape(shape + (3,))
-            i += 3
+    grads: dict[str, np.ndarray] = {}
+    # a scalar parameter's derivative alone in its pass is that pass's plane (the twin stores 0 in the
+    # channels it does not reach); the others are laid out by one parallel scatter, a column each in
+    # the order of dirs (an RGB parameter's three consecutive)
+    whole = {members[0]: g for g, members in enumerate(groups) if len(members) == 1 and dirs[members[0]][1] is None}
+    rest = [i for i in range(len(dirs)) if i not in whole]
+    for i, g in whole.items():
+        grads[dirs[i][0]] = planes[g].reshape(shape)
+    if rest:
+        group_of = {i: g for g, members in enumerate(groups) for i in members}
+        src = np.full((3, len(rest)), -1, dtype=np.int64)
+        for col, i in enumerate(rest):
+            for c_out in touched[i]:
+                src[c_out, col] = group_of[i]
+        gout = np.empty((npairs, 3, len(rest)), dtype=ft)
+        with _driver.may_compile((_scatter, planes.dtype)):
+            _scatter(planes, src, gout)
+        block = gout.reshape(shape + (len(rest),))
+        for col, i in enumerate(rest):
+            name, ch, _ = dirs[i]
+            if ch is None:
+                grads[name] = block[..., col]
+            elif ch == 0:  # channel_in 0, 1, 2: [..., channel_out, channel_in]
+                grads[name] = block[..., col:col + 3]
     return out.reshape(shape), grads
 
 
