@@ -108,16 +108,19 @@ def exact_jacobian(packer: ParamPacker, data: Samples, metric: str) -> Callable[
         m = prepared.model(x)
         f, grads = m.eval_grad(data.wi, data.wo, wrt=wrt)
         f = np.asarray(f, np.float64)
-        J = np.empty((n, 3, k))
+        # built column by column, each contiguous, then laid out (3n, k) in one copy: writing the
+        # columns of a (3n, k) array in place strides across every row (0.59 ms of a 9000 × 16
+        # Jacobian, against 0.5 ms for eval_grad itself); the products are the same, in the same order
+        Jc = np.empty((k, n, 3))
         for i, (name, ch, twin) in enumerate(columns):
             g = grads[name] if ch is None else grads[name][..., ch]
             if twin is not None:
                 g = g + (grads[twin] if ch is None else grads[twin][..., ch])
-            J[:, :, i] = g
+            Jc[i] = g
         dvdx = np.where(logs, np.exp(np.asarray(x, np.float64)), 1.0)
-        J *= (sw * slope(f, c))[:, :, None]
-        J *= dvdx
-        return J.reshape(3 * n, k)
+        Jc *= sw * slope(f, c)
+        Jc *= dvdx[:, None, None]
+        return np.ascontiguousarray(Jc.transpose(1, 2, 0)).reshape(3 * n, k)
 
     return jac
 
