@@ -93,29 +93,39 @@ def _times(fn, calls: int, warm: int = 2) -> tuple[float, float]:
 
 
 # --------------------------------------------------------------------------- workers (one per process)
-def worker_mitsuba(n: int, calls: int, threads: int = 0) -> dict:
+def _mitsuba(threads: int):
+    """``(mi, dr, bsdf, to_dr)``: Mitsuba's ``llvm_ad_rgb`` variant, its GGX ``roughconductor`` at the
+    benchmark's parameters, and a numpy ``(n, 3)`` array as a Dr.Jit vector."""
     import drjit as dr
     import mitsuba as mi
 
     if threads:
         dr.set_thread_count(threads)
     mi.set_variant("llvm_ad_rgb")
-    bsdf = mi.load_dict(
-        {
-            "type": "roughconductor",
-            "distribution": "ggx",
-            "alpha": ALPHA,
-            "eta": {"type": "rgb", "value": list(ETA)},
-            "k": {"type": "rgb", "value": list(K)},
-        }
-    )
-    wi, wo = directions(n)
-    wi32, wo32 = wi.astype(np.float32), wo.astype(np.float32)
-    ctx = mi.BSDFContext()
+    bsdf = mi.load_dict({"type": "roughconductor", "distribution": "ggx", "alpha": ALPHA,
+                         "eta": {"type": "rgb", "value": list(ETA)}, "k": {"type": "rgb", "value": list(K)}})
 
     def to_dr(a):
         return mi.Vector3f(a[:, 0], a[:, 1], a[:, 2])
 
+    return mi, dr, bsdf, to_dr
+
+
+def _brdfkit_model():
+    """brdfkit's model of the same BRDF (module docstring), on the compiled engine."""
+    import brdfkit as bk
+    from brdfkit import engine
+
+    engine.set_engine("compiled")
+    return bk.model("microfacet", distribution="ggx", shadowing="smith", fresnel="conductor",
+                    alpha=ALPHA, eta=ETA, k=K, kd=0.0, ks=1.0)
+
+
+def worker_mitsuba(n: int, calls: int, threads: int = 0) -> dict:
+    mi, dr, bsdf, to_dr = _mitsuba(threads)
+    wi, wo = directions(n)
+    wi32, wo32 = wi.astype(np.float32), wo.astype(np.float32)
+    ctx = mi.BSDFContext()
     si = dr.zeros(mi.SurfaceInteraction3f, n)
     si.wi = to_dr(wo32)  # Mitsuba's wi is our wo (toward the viewer)
     d_light = to_dr(wi32)
@@ -145,12 +155,7 @@ def worker_mitsuba(n: int, calls: int, threads: int = 0) -> dict:
 
 
 def worker_brdfkit(n: int, calls: int, threads: int = 0) -> dict:
-    import brdfkit as bk
-    from brdfkit import engine
-
-    engine.set_engine("compiled")
-    m = bk.model("microfacet", distribution="ggx", shadowing="smith", fresnel="conductor",
-                 alpha=ALPHA, eta=ETA, k=K, kd=0.0, ks=1.0)
+    m = _brdfkit_model()
     wi, wo = directions(n)
     out = {}
     for name, dt, order in (("f32_s", np.float32, "C"), ("f64_s", np.float64, "C"),
@@ -163,22 +168,12 @@ def worker_brdfkit(n: int, calls: int, threads: int = 0) -> dict:
 
 def worker_mitsuba_grad(n: int, calls: int, threads: int = 0) -> dict:
     """Mitsuba's eval and its forward-mode derivatives (``--grad``), numpy in and out."""
-    import drjit as dr
-    import mitsuba as mi
-
-    if threads:
-        dr.set_thread_count(threads)
-    mi.set_variant("llvm_ad_rgb")
-    bsdf = mi.load_dict({"type": "roughconductor", "distribution": "ggx", "alpha": ALPHA,
-                         "eta": {"type": "rgb", "value": list(ETA)}, "k": {"type": "rgb", "value": list(K)}})
+    mi, dr, bsdf, to_dr = _mitsuba(threads)
     params = mi.traverse(bsdf)
     keys = ("alpha.value", "eta.value", "k.value")
     wi, wo = directions(n)
     wi32, wo32 = wi.astype(np.float32), wo.astype(np.float32)
     ctx = mi.BSDFContext()
-
-    def to_dr(a):
-        return mi.Vector3f(a[:, 0], a[:, 1], a[:, 2])
 
     def evaluate():
         s = dr.zeros(mi.SurfaceInteraction3f, n)
@@ -214,12 +209,7 @@ def worker_mitsuba_grad(n: int, calls: int, threads: int = 0) -> dict:
 
 def worker_brdfkit_grad(n: int, calls: int, threads: int = 0) -> dict:
     """brdfkit's eval and eval_grad of the same BRDF (``--grad``), float32."""
-    import brdfkit as bk
-    from brdfkit import engine
-
-    engine.set_engine("compiled")
-    m = bk.model("microfacet", distribution="ggx", shadowing="smith", fresnel="conductor",
-                 alpha=ALPHA, eta=ETA, k=K, kd=0.0, ks=1.0)
+    m = _brdfkit_model()
     wi, wo = (w.astype(np.float32) for w in directions(n))
     out = {}
     for name, fn in (("eval", lambda: m.eval(wi, wo)), ("one", lambda: m.eval_grad(wi, wo, wrt="alpha")),

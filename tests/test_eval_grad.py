@@ -505,7 +505,6 @@ def test_schlick_tiny_isotropy_has_no_nan_derivative(eng):
     the float range (−inf) once p < 1e-205."""
     rng = np.random.default_rng(4)
     wi, wo = random_unit_vectors(200, rng), random_unit_vectors(200, rng)
-    wi[:, 2], wo[:, 2] = np.abs(wi[:, 2]), np.abs(wo[:, 2])
     wi[:4, 0] = wo[:4, 0] = 0.0  # h in the y-z plane: w = 0
     wi /= np.linalg.norm(wi, axis=1, keepdims=True)
     wo /= np.linalg.norm(wo, axis=1, keepdims=True)

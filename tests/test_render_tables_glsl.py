@@ -17,6 +17,7 @@ import pytest
 
 import brdfkit as bk
 from brdfkit.measured.utia import tabulate_utia, write_utia_table
+from brdfkit.memo import Held
 from brdfkit.render import glsl, tables
 from _numeric_helpers import peak_pairs
 
@@ -120,7 +121,7 @@ def test_table_set_is_built_once_and_read_only(files):
 
 
 def test_held_keeps_the_last_ones_by_key():
-    held, built = tables.Held(2), []
+    held, built = Held(2), []
 
     def build(v):
         return lambda: built.append(v) or v

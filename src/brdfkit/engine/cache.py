@@ -170,7 +170,8 @@ def load_generated(folder: str, stem: str, src: str, package: str) -> types.Modu
 JIT_OPTIONS = dict(cache=True, error_model="numpy", nogil=True)
 
 
-def jit(fn: Callable | None = None, *, inline: bool = False, reassociate: bool = False) -> Callable:
+def jit(fn: Callable | None = None, *, inline: bool = False, reassociate: bool = False,
+        parallel: bool = False) -> Callable:
     """Decorator for scalar terms and kernels: nopython, cached, ``error_model="numpy"``, no fastmath (but ``reassociate``).
 
     ``@jit(inline=True)`` also inlines the function into its numba callers (numba IR
@@ -183,12 +184,17 @@ def jit(fn: Callable | None = None, *, inline: bool = False, reassociate: bool =
     ``reassoc`` fast-math flag, nothing else): a reduction loop then vectorises. Only for a sum
     of terms of one sign (HTSG's series), where the order changes the rounding by a few ulp and
     nothing else (no NaN, inf or signed-zero change).
+
+    ``@jit(parallel=True)``: numba's ``parallel=True`` (a ``numba.prange`` loop runs on its thread pool),
+    for a whole-array helper such as :func:`brdfkit.engine.grad`'s scatter, not for a kernel.
     """
     if fn is None:
-        return lambda f: jit(f, inline=inline, reassociate=reassociate)
+        return lambda f: jit(f, inline=inline, reassociate=reassociate, parallel=parallel)
     opts = dict(JIT_OPTIONS, inline="always") if inline else dict(JIT_OPTIONS)
     if reassociate:
         opts["fastmath"] = {"reassoc"}
+    if parallel:
+        opts["parallel"] = True
     with in_cache_dir():
         return numba.njit(**opts)(fn)
 

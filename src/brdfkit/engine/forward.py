@@ -808,6 +808,11 @@ def _closure(stem: str) -> list[str]:
     return out
 
 
+def _ours(module: str) -> bool:
+    """Whether a function of ``module`` is brdfkit's own: its source is in the hash that names the cache folder."""
+    return module.split(".")[0] == "brdfkit"
+
+
 def _manifest_path(stem: str):
     from .cache import cache_dir
     return cache_dir() / "forward" / f"{stem}.json"
@@ -823,9 +828,9 @@ def _save_manifest(stem: str) -> None:
     from ..fileio import write_text
 
     order = _closure(stem)
-    if not all(_MADE[s][3].split(".")[0] == "brdfkit" for s in order):
+    if not all(_ours(_MADE[s][3]) for s in order):
         return
-    entries = [{"stem": s, "name": _MADE[s][0], "deps": _MADE[s][2],
+    entries = [{"stem": s, "name": _MADE[s][0], "deps": _MADE[s][2], "module": _MADE[s][3],
                 "rets": [sorted(r) for r in _MADE[s][1]]} for s in order]
     try:
         write_text(_manifest_path(stem), json.dumps({"closure": entries}))
@@ -838,9 +843,10 @@ def _load_manifest(stem: str) -> tuple[Callable, tuple] | None:
     (no manifest, or a file missing or unreadable: then the caller analyses the source)."""
     import json
 
+    path = _manifest_path(stem)
     try:
-        entries = json.loads(_manifest_path(stem).read_text())["closure"]
-        where = _manifest_path(stem).parent
+        entries = json.loads(path.read_text())["closure"]
+        where = path.parent
         for e in entries:
             s = e["stem"]
             if s not in _BY_KEY:
@@ -848,7 +854,7 @@ def _load_manifest(stem: str) -> tuple[Callable, tuple] | None:
                 twin = _load(s, src, e["name"])
                 _KEY_OF[id(twin)] = s
                 _BY_KEY[s] = twin
-            _MADE.setdefault(s, (e["name"], tuple(frozenset(r) for r in e["rets"]), list(e["deps"]), "brdfkit"))
+            _MADE.setdefault(s, (e["name"], tuple(frozenset(r) for r in e["rets"]), list(e["deps"]), e["module"]))
         return _BY_KEY[stem], _MADE[stem][1]
     except (OSError, ValueError, KeyError, TypeError, AttributeError, ImportError):
         return None
@@ -869,7 +875,7 @@ def forward_kernel(kernel: Callable, seeds, direction: int | None = None) -> tup
     key = (id(py), pats, seeds, direction)
     with _LOCK:
         hit = _TWINS.get(key)
-        if hit is None and py.__module__.split(".")[0] == "brdfkit":
+        if hit is None and _ours(py.__module__):
             hit = _load_manifest(_stem(py, pats, seeds, direction))
             if hit is not None:
                 _TWINS[key] = hit

@@ -36,7 +36,7 @@ import numba
 
 from . import driver as _driver
 from .active import engine
-from .cache import in_cache_dir
+from .cache import jit
 from .evaluate import prepare
 from .forward import Unsupported, forward_kernel, _KEY_OF
 from .generated import _load
@@ -383,7 +383,8 @@ def eval_grad(model, wi, wo, wrt=None):
     return f, {k: grads[k] for k in names}
 
 
-def _scatter_py(planes, src, gout):
+@jit(parallel=True)
+def _scatter(planes, src, gout):
     """``gout[j, c, k] = planes[src[c, k], j, c]`` (0 where ``src[c, k] < 0``): the directional passes'
     planes laid out as eval_grad's ``(n, 3, derivatives)`` block, in one parallel pass over the pairs."""
     n = gout.shape[0]
@@ -394,10 +395,6 @@ def _scatter_py(planes, src, gout):
             for k in range(m):
                 g = src[c, k]
                 gout[j, c, k] = planes[g, j, c] if g >= 0 else zero
-
-
-with in_cache_dir():
-    _scatter = numba.njit(parallel=True, cache=True, nogil=True, error_model="numpy")(_scatter_py)
 
 
 def _eval_directional(model, kernel, p, c, fi, fo, shape, f32: bool, dirs, n: int, groups, touched):

@@ -101,7 +101,8 @@ import numpy as np
 
 from ..geometry import normalize, random_unit_vectors, reflect, spherical_to_vector
 from .context import EGLCurrent as _EGLCurrent, context_info, create_context
-from .tables import Held, kept_key, read_only
+from ..memo import Held
+from .tables import kept_key, read_only
 
 SHADER_DIR = Path(__file__).resolve().with_name("shaders")
 

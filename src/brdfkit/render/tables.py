@@ -222,4 +222,4 @@ def unpack(data: bytes) -> tuple[dict[str, Any], list[np.ndarray]]:
 
 
 __all__ = ["Texture", "TableSet", "FIRST_UNIT", "FORMATS", "format_of", "rgl_tables", "utia_tables", "table_set",
-           "table_set_key", "kept_key", "Held", "read_only", "header", "pack", "unpack"]
+           "table_set_key", "kept_key", "read_only", "header", "pack", "unpack"]
