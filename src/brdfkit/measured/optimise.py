@@ -6,15 +6,17 @@ any isotropic model): its free values (:mod:`brdfkit.measured.packing`) minimise
 (:mod:`brdfkit.measured.metrics`) over weighted measured samples
 (:mod:`brdfkit.measured.samples`).
 
-Optimiser: ``scipy.optimize.least_squares`` (trust-region reflective, bounds) from several
+Optimiser: bounded trust-region reflective least squares (Branch, Coleman & Li 1999) from several
 starts: the parameters' defaults plus the best of a few dozen random points of the bounded
 parameter space (multi-start, so a local minimum does not decide); the best result wins. A
 start that enters the basin of a minimum an earlier start converged to (within
 :data:`JOIN_XTOL` of it in every free value, :data:`JOIN_RTOL` in cost) stops there; its
 ``start_errors`` entry is the error it had then. The Jacobian is the model's exact one, from
-its ``eval_grad`` (:mod:`brdfkit.measured.exact_jacobian`); for a model with no gradient (a
-``.brdf`` file's GLSL, ``multiscatter``) it is by forward differences, cheaper where the model
-allows (:mod:`brdfkit.measured.jacobian`). A ``samples="table"``
+its ``eval_grad`` (:mod:`brdfkit.measured.exact_jacobian`), and the solver
+:mod:`brdfkit.measured.trust_region` (scipy's ``trf`` rules with the exact subproblem, on the n × n
+normal matrix); for a model with no gradient (a ``.brdf`` file's GLSL, ``multiscatter``) the
+Jacobian is by forward differences, cheaper where the model allows
+(:mod:`brdfkit.measured.jacobian`), and the solver ``scipy.optimize.least_squares`` (``trf``, LSMR). A ``samples="table"``
 fit searches on :data:`TABLE_SEARCH_SAMPLES` of the bins and polishes the best start on all
 of them (:func:`_polish`).
 """
@@ -31,6 +33,7 @@ from typing import Any, Callable, Mapping
 import numpy as np
 
 from ..models.base import BRDF
+from . import trust_region
 from .exact_jacobian import exact_jacobian
 from .jacobian import channel_groups, constant_columns, jacobian, probe_columns
 from .lobes import two_lobe
@@ -114,10 +117,8 @@ def _local(residuals, x0, packer, max_nfev, tol, known=(), const=None, groups=No
     :func:`constant_columns` of the Jacobian; ``groups``: its :func:`channel_groups`.
     ``exact``: the model's exact Jacobian (:func:`exact_jacobian`), used instead of differences;
     each of its calls counts as one evaluation."""
-    from scipy.optimize import least_squares
-
     x0 = np.clip(x0, packer.lb, packer.ub)
-    # least_squares needs x0 strictly inside the bounds
+    # both solvers need x0 strictly inside the bounds
     eps = 1e-9 * np.maximum(1.0, packer.ub - packer.lb)
     x0 = np.minimum(np.maximum(x0, packer.lb + eps), packer.ub - eps)
     # a model evaluated in float32 (a .brdf file's GLSL) declares a finite-difference step its
@@ -125,15 +126,20 @@ def _local(residuals, x0, packer, max_nfev, tol, known=(), const=None, groups=No
     diff_step = getattr(packer.cls, "fit_diff_step", None)
     fn = _Start(residuals, packer, list(known))
     grouped = groups is not None and any(len(g) > 1 for g in groups)
-    if exact is not None:
-        jac = _counted(exact, fn)
-    else:
-        jac = jacobian(fn, packer, const or {}, groups if grouped else None) if const or grouped else "2-point"
     try:
-        res = least_squares(
-            fn, x0, jac=jac, bounds=(packer.lb, packer.ub), method="trf", x_scale="jac", tr_solver="lsmr",
-            max_nfev=max_nfev, xtol=tol, ftol=tol, gtol=tol, diff_step=diff_step,
-        )
+        if exact is not None:
+            # the exact Jacobian: the same trust-region reflective rules as scipy's, on the n × n
+            # normal matrix (brdfkit.measured.trust_region), 2x faster per fit than scipy's SVD
+            res = trust_region.solve(fn, _counted(exact, fn), x0, packer.lb, packer.ub, max_nfev=max_nfev,
+                                     xtol=tol, ftol=tol, gtol=tol)
+        else:
+            from scipy.optimize import least_squares
+
+            jac = jacobian(fn, packer, const or {}, groups if grouped else None) if const or grouped else "2-point"
+            res = least_squares(
+                fn, x0, jac=jac, bounds=(packer.lb, packer.ub), method="trf", x_scale="jac", tr_solver="lsmr",
+                max_nfev=max_nfev, xtol=tol, ftol=tol, gtol=tol, diff_step=diff_step,
+            )
     except _Joined as j:
         return j.x, j.cost, fn.nfev, True, True
     return res.x, float(2 * res.cost), fn.nfev, False, res.status > 0
