@@ -11,7 +11,7 @@ from scipy.optimize._numdiff import approx_derivative
 from brdfkit import registry
 from brdfkit.measured import fit as F
 from brdfkit.measured import optimise
-from brdfkit.measured.exact_jacobian import exact_jacobian
+from brdfkit.measured.exact_jacobian import exact_jacobian, normal_equations
 
 MATERIAL = "merl/gold-metallic-paint"
 
@@ -99,3 +99,43 @@ def test_exact_fit_ends_no_higher_than_the_difference_fit(monkeypatch):
     assert exact.error <= fd.error * (1 + 1e-6), (exact.error, fd.error)
     # the value it reports is the metric of the parameters it reports
     assert exact.error == pytest.approx(F.error(exact.model, data, "ngan"), rel=1e-9)
+
+
+@pytest.mark.parametrize("metric", ["ngan", "log"])
+def test_normal_equations_are_the_sum_over_blocks(metric):
+    """JᵀJ and Jᵀr built block by block (blocks of 700 samples, the last one shorter) equal those of
+    the whole exact Jacobian: each block's 1/√(3·block) weighting rescaled to the whole vector's."""
+    data = F.sample(MATERIAL, n=2500, seed=3)
+    packer = F.ParamPacker(registry.get("microfacet"), {"distribution": "ggx", "fresnel": "schlick"},
+                           tie_isotropic=True)
+    res = F.residual_fn(packer, data, F.transform(metric), metric)
+    normal = normal_equations(packer, data, metric, chunk=700)
+    x = next(_points(packer, np.random.default_rng(4), 1))
+    r = res(x)
+    JtJ, Jtr = normal(x, r)
+    Jt = exact_jacobian(packer, data, metric)(x)
+    np.testing.assert_allclose(JtJ, Jt @ Jt.T, rtol=1e-10, atol=1e-12 * np.abs(JtJ).max())
+    np.testing.assert_allclose(Jtr, Jt @ r, rtol=1e-10, atol=1e-12 * np.abs(Jtr).max())
+    assert normal_equations(F.ParamPacker(registry.get("microfacet"), {"multiscatter": True}, tie_isotropic=True),
+                            data, metric) is None
+
+
+def test_table_scale_fit_polishes_with_the_exact_jacobian(monkeypatch):
+    """A samples="table" fit polishes on every bin with the normal equations of the exact Jacobian
+    (one gradient evaluation per step instead of a difference per free value), and ends where the
+    difference polish ends."""
+    data = F.table(MATERIAL, 30)
+    calls = []
+
+    def counted(*a, **k):
+        calls.append(1)
+        return normal_equations(*a, **k)
+
+    monkeypatch.setattr(optimise, "normal_equations", counted)
+    exact = F.fit("ward", MATERIAL, samples="table", data=data, max_theta_deg=30)
+    assert calls
+    monkeypatch.setattr(optimise, "EXACT_JACOBIAN", False)
+    diff = F.fit("ward", MATERIAL, samples="table", data=data, max_theta_deg=30)
+    assert len(calls) == 1  # the difference fit does not build them
+    assert exact.error <= diff.error * (1 + 1e-7)
+    assert exact.nfev < diff.nfev

@@ -126,4 +126,42 @@ def exact_jacobian(packer: ParamPacker, data: Samples, metric: str) -> Callable[
     return jac
 
 
-__all__ = ["exact_jacobian", "CBRT_FLOOR"]
+#: samples per block of :func:`normal_equations`: one block's transposed Jacobian (slots × 3 × this,
+#: float64) and its gradient pass are all it holds at once (16 slots: 25 MB)
+NORMAL_CHUNK = 65536
+
+
+def normal_equations(packer: ParamPacker, data: Samples, metric: str, chunk: int = NORMAL_CHUNK
+                     ) -> Callable[[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]] | None:
+    """``(x, r) ↦ (JᵀJ, Jᵀr)`` for the residuals of :func:`~brdfkit.measured.residuals.residual_fn` over
+    ``data`` (``r``: those residuals at ``x``), from the exact Jacobian block by block of ``chunk``
+    samples, so that a table-scale fit (909 696 MERL bins: a 2.7 M × slots Jacobian) never holds
+    more than one block's; ``None`` where the model has no gradient (:func:`exact_jacobian`).
+
+    A block's Jacobian weights its residuals by ``1/√(3·block)``; the whole vector's by
+    ``1/√(3n)``: each block is rescaled by ``√(block/n)``."""
+    blocks = []
+    n = len(data)
+    for a in range(0, n, chunk):
+        b = min(a + chunk, n)
+        part = Samples(data.wi[a:b], data.wo[a:b], data.f[a:b], data.w[a:b], data.source, data.isotropic)
+        jac_t = exact_jacobian(packer, part, metric)
+        if jac_t is None:
+            return None
+        blocks.append((3 * a, 3 * b, jac_t, math.sqrt((b - a) / n)))
+    k = len(packer)
+
+    def normal(x: np.ndarray, r: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        JtJ = np.zeros((k, k))
+        Jtr = np.zeros(k)
+        for a, b, jac_t, s in blocks:
+            Jt = jac_t(x)
+            Jt *= s
+            JtJ += Jt @ Jt.T
+            Jtr += Jt @ np.asarray(r[a:b], np.float64)
+        return JtJ, Jtr
+
+    return normal
+
+
+__all__ = ["exact_jacobian", "normal_equations", "CBRT_FLOOR", "NORMAL_CHUNK"]

@@ -34,7 +34,7 @@ import numpy as np
 
 from ..models.base import BRDF
 from . import trust_region
-from .exact_jacobian import exact_jacobian
+from .exact_jacobian import exact_jacobian, normal_equations
 from .jacobian import channel_groups, constant_columns, jacobian, probe_columns
 from .lobes import two_lobe
 from .metrics import METRICS, error, transform
@@ -182,31 +182,27 @@ def _engine_threads(n_samples: int):
 POLISH_ITERATIONS = 4
 
 
-def _polish(residuals, x, packer: ParamPacker, iterations: int = POLISH_ITERATIONS) -> tuple[np.ndarray, int]:
+def _polish(residuals, x, packer: ParamPacker, iterations: int = POLISH_ITERATIONS, normal=None
+            ) -> tuple[np.ndarray, int]:
     """A few bounded Levenberg-Marquardt steps on a large residual vector (every table bin).
 
-    ``least_squares`` would hold the whole (residuals × parameters) Jacobian and run LSMR
-    on it (2.7 M × 10 for a table: seconds per iteration); here the forward-difference
-    columns are reduced at once to the normal equations JᵀJ (n × n) and Jᵀr, and a step is
-    kept only if it lowers the cost, so the result is never worse than the start.
-    Returns ``(x, evaluations)``."""
+    A solver that holds the whole (residuals × parameters) Jacobian would need 2.7 M × 10 values
+    for a table (and scipy's LSMR seconds per iteration); here the Jacobian is reduced at once to the
+    normal equations JᵀJ (n × n) and Jᵀr: ``normal(x, r)`` gives them from the model's exact Jacobian
+    block by block (:func:`~brdfkit.measured.exact_jacobian.normal_equations`, one evaluation),
+    else they come from forward-difference columns (n evaluations). A step is kept only if it
+    lowers the cost, so the result is never worse than the start. Returns ``(x, evaluations)``."""
     n = len(x)
     r = residuals(x)
     cost = float(r @ r)
     used, lam = 1, 1e-3
     for _ in range(iterations):
-        J = np.empty((n, r.size), np.float32)  # forward-difference columns, as rows
-        for i in range(n):
-            h = 1e-6 * max(1.0, abs(float(x[i])))
-            if x[i] + h > packer.ub[i]:
-                h = -h
-            y = x.copy()
-            y[i] += h
-            J[i] = (residuals(y) - r) / h
+        if normal is not None:
+            JtJ, Jtr = normal(x, r)
             used += 1
-        JtJ = (J @ J.T).astype(np.float64)
-        Jtr = (J @ r.astype(np.float32)).astype(np.float64)
-        del J
+        else:
+            JtJ, Jtr = _difference_normal(residuals, x, r, packer)
+            used += n
         improved = False
         for _try in range(6):
             A = JtJ + lam * np.diag(np.maximum(np.diag(JtJ), 1e-30))
@@ -226,6 +222,19 @@ def _polish(residuals, x, packer: ParamPacker, iterations: int = POLISH_ITERATIO
         if not improved:
             break
     return x, used
+
+
+def _difference_normal(residuals, x, r, packer: ParamPacker) -> tuple[np.ndarray, np.ndarray]:
+    """JᵀJ and Jᵀr from forward-difference columns (float32 rows: 2.7 M × n for a table)."""
+    J = np.empty((len(x), r.size), np.float32)
+    for i in range(len(x)):
+        h = 1e-6 * max(1.0, abs(float(x[i])))
+        if x[i] + h > packer.ub[i]:
+            h = -h
+        y = x.copy()
+        y[i] += h
+        J[i] = (residuals(y) - r) / h
+    return (J @ J.T).astype(np.float64), (J @ r.astype(np.float32)).astype(np.float64)
 
 
 #: samples of the multi-start search of a ``samples="table"`` fit (the polish runs on every bin)
@@ -310,7 +319,8 @@ def fit(
             if cst < best_cost:
                 best_cost, best_x = cst, x
         if search is not data:  # polish the best start on every bin
-            best_x, used = _polish(residual_fn(packer, data, T, metric), best_x, packer)
+            normal = normal_equations(packer, data, metric) if plan.exact is not None else None
+            best_x, used = _polish(residual_fn(packer, data, T, metric), best_x, packer, normal=normal)
             nfev += used
             step(total)
     # the model of the reported parameters: a subnormal value (kd pressed to 0) as 0 (brdfkit.measured.result)
