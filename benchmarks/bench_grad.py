@@ -9,7 +9,11 @@ pairs: ``m.eval``, ``m.eval_grad`` (every continuous parameter) and ``m.eval_gra
 warm-up (which loads or compiles the driver), in millions of pairs per second, and the ratios
 gradient/eval. ``outputs`` is the number of nonzero derivative values per pair (at the first pair: 3
 channels × the parameter components that reach that channel): a gradient call writes that many numbers where ``eval``
-writes 3, so its memory traffic alone bounds the ratio.
+writes 3, so its memory traffic alone bounds the ratio. ``bound`` measures that bound for the layout
+eval_grad returns (SPEC.md: an RGB parameter's derivative is ``(..., 3, 3)``, zeros included, and
+``alpha`` beside ``alpha_x``/``alpha_y``): eval's time over the time a compiled parallel loop takes to
+write as many values per pair into freshly allocated arrays, as eval_grad does; no gradient of every
+parameter in that layout can be faster than that fraction of eval.
 
 Alternating rounds (eval, grad, grad-wrt, eval, ...) so that a load change on the shared machine
 touches all three alike; the load average is printed. Nothing is asserted.
@@ -48,6 +52,28 @@ def _best(fn, repeat: int) -> float:
     return best
 
 
+_FILL = None
+
+
+def _write_time(values_per_pair: int, wi: np.ndarray, repeat: int) -> float:
+    """Best time to write ``values_per_pair`` values of ``wi``'s dtype per pair into a fresh (n, k) array
+    with a compiled parallel loop (each value a cheap function of the pair's direction)."""
+    global _FILL
+    if _FILL is None:
+        import numba
+
+        @numba.njit(parallel=True)
+        def fill(w, out):
+            for j in numba.prange(out.shape[0]):
+                s = w[j, 0] + w[j, 1] + w[j, 2]
+                for k in range(out.shape[1]):
+                    out[j, k] = s
+
+        _FILL = fill
+    _FILL(wi, np.empty((wi.shape[0], values_per_pair), wi.dtype))  # compile
+    return _best(lambda: _FILL(wi, np.empty((wi.shape[0], values_per_pair), wi.dtype)), repeat)
+
+
 def run(n: int, repeat: int, cases=CASES, progress: bool = True) -> list[dict]:
     import brdfkit as bk
     from rich.progress import Progress
@@ -74,10 +100,13 @@ def run(n: int, repeat: int, cases=CASES, progress: bool = True) -> list[dict]:
                         best[k] = min(best[k], _best(fn, 1))
                 _, g = m.eval_grad(wi[:1], wo[:1])  # a generic pair: structural zeros are the only zeros
                 outputs = int(sum(np.count_nonzero(v) for k, v in g.items() if not (k == "alpha" and "alpha_x" in g)))
+                returned = int(sum(v[0].size for v in g.values()))  # every value the call writes per pair
+                write = _write_time(returned, wi, repeat)
                 rows.append({"case": label, "dtype": dt.__name__, "n": n, "wrt": wrt, "outputs_per_pair": outputs,
                              **{f"{k}_mpairs_per_s": n / t / 1e6 for k, t in best.items()},
                              "grad_vs_eval": best["eval"] / best["grad"],
-                             "grad_wrt_vs_eval": best["eval"] / best["grad_wrt"]})
+                             "grad_wrt_vs_eval": best["eval"] / best["grad_wrt"],
+                             "returned_per_pair": returned, "write_bound_vs_eval": best["eval"] / write})
                 bar.advance(task)
     return rows
 
@@ -97,12 +126,13 @@ def main(argv: list[str] | None = None) -> int:
     from rich.table import Table
 
     t = Table(title=f"eval_grad beside eval, 2^{args.log2n} pairs, compiled engine (load average {_load()})")
-    for col in ("case", "dtype", "outputs/pair", "eval M/s", "grad M/s", "grad/eval", "wrt", "grad(wrt) M/s",
-                "grad(wrt)/eval"):
+    for col in ("case", "dtype", "outputs/pair", "eval M/s", "grad M/s", "grad/eval", "bound", "wrt",
+                "grad(wrt) M/s", "grad(wrt)/eval"):
         t.add_column(col, justify="left" if col in ("case", "dtype", "wrt") else "right")
     for r in rows:
         t.add_row(r["case"], r["dtype"], str(r["outputs_per_pair"]), f"{r['eval_mpairs_per_s']:.1f}",
-                  f"{r['grad_mpairs_per_s']:.2f}", f"{r['grad_vs_eval']:.3f}", r["wrt"],
+                  f"{r['grad_mpairs_per_s']:.2f}", f"{r['grad_vs_eval']:.3f}",
+                  f"{r['write_bound_vs_eval']:.2f} ({r['returned_per_pair']})", r["wrt"],
                   f"{r['grad_wrt_mpairs_per_s']:.2f}", f"{r['grad_wrt_vs_eval']:.3f}")
     Console(width=150).print(t)
     return 0
