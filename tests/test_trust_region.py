@@ -133,10 +133,12 @@ def test_max_nfev_stops_with_status_0():
     assert got.cost == pytest.approx(ref.cost, rel=1e-12)
 
 
-def test_non_finite_start_is_a_value_error():
+def test_non_finite_start_and_empty_box_are_value_errors():
     with pytest.raises(ValueError, match="not finite at the initial point"):
         TR.solve(lambda x: np.array([np.nan, x[0]]), lambda x: np.ones((1, 2)), np.array([0.5]),
                  np.array([0.0]), np.array([1.0]))
+    with pytest.raises(ValueError, match="lower bound must be below"):
+        TR.solve(lambda x: x, lambda x: np.eye(1), np.array([0.5]), np.array([1.0]), np.array([1.0]))
 
 
 def test_non_finite_trial_point_shrinks_the_radius():

@@ -82,6 +82,8 @@ def solve(
     residual evaluations allowed (default 100 n). ValueError if ``fun(x0)`` is not finite."""
     lb = np.asarray(lb, np.float64)
     ub = np.asarray(ub, np.float64)
+    if not np.all(lb < ub):
+        raise ValueError("each lower bound must be below its upper bound")
     x = _strictly_feasible(np.array(x0, np.float64), lb, ub)
     n = x.size
     max_nfev = 100 * n if max_nfev is None else max_nfev
@@ -137,7 +139,8 @@ def solve(
                                   ftol, xtol)
             if status is not None:
                 break
-            alpha *= delta / delta_new
+            if delta_new > 0:  # 0 only after a zero step, which the xtol test has already stopped
+                alpha *= delta / delta_new
             delta = delta_new
         if actual > 0:
             x, f, cost = x_new, f_new, cost_new
@@ -167,8 +170,8 @@ def _subproblem(lam, V, w, delta: float, alpha: float) -> tuple[np.ndarray, floa
     fits (A resolvably positive definite), else p(α) = −V w/(λ + α) with ‖p(α)‖ ≈ Δ (Moré 1978,
     ``alpha``: the last call's α as the first guess). Returns ``(p̂, α)``."""
     w_norm = float(np.linalg.norm(w))
-    if w_norm == 0.0:
-        return np.zeros_like(w), 0.0
+    if w_norm == 0.0 or delta <= 0.0:
+        return np.zeros_like(w), alpha
     # λ_min resolvable in a normal matrix whose entries carry ε·λ_max of rounding
     full_rank = lam[0] > EPS * lam.size * lam[-1]
     if full_rank:
