@@ -31,18 +31,28 @@ def _bar(title: str, total: int, unit: str = "starts"):
 @contextmanager
 def fit_progress(progress: bool | Callable[[int, int], None], title: str, total: int,
                  unit: str = "starts") -> Iterator[Callable[[int], None]]:
-    """``step(done)``, to call as each of ``total`` steps (local starts, a polish) ends.
+    """``step(done)``, to call as each of ``total`` steps (local starts, a polish) ends;
+    ``step.total(n)`` raises the number of steps to ``n``.
 
     ``progress``: ``True`` for the bar (titled ``title``), a callable ``(done, total)`` called at
     every step, or ``False`` for neither. The bar is taken down on leaving, also on an error."""
     callback = progress if callable(progress) else None
     shown = _bar(title, total, unit) if progress is True else None
+    steps = [total]
 
     def step(done: int) -> None:
         if shown is not None:
             shown[0].update(shown[1], advance=1)
         if callback is not None:
-            callback(done, total)
+            callback(done, steps[0])
+
+    def grow(new_total: int) -> None:
+        """More steps than announced (a fit that searches on): the bar's and the callback's total."""
+        steps[0] = new_total
+        if shown is not None:
+            shown[0].update(shown[1], total=new_total)
+
+    step.total = grow
 
     try:
         yield step
