@@ -183,9 +183,10 @@ def _engine_threads(n_samples: int):
 #: more runs start from the next best candidates, to the rougher tolerance :data:`EXTRA_TOL`; one that
 #: ends below the best minimum so far converges on from there to the fit's own tolerance, and the best
 #: result wins. On the 159 × 9 table (docs/measured.md) 207 of 1431 fits searched on (155 of them
-#: He's), the table took 168 s against 206 s without (same load range), and He on rgl/chm_mint_rgb
-#: went from 2.380 to 2.085, its published loss; gold-metallic-paint's conductor fit, whose starts
-#: end in two basins 7 % apart, takes 0.33 s against 0.22 s (0.58 s with the extra runs at full tolerance)
+#: He's) and He on rgl/chm_mint_rgb went from 2.380 to 2.085, its published loss; the whole table took
+#: 168 s (206 s in a run without them: this machine's noise exceeds their cost there), but
+#: gold-metallic-paint's conductor fit, whose starts end in two basins 7 % apart, takes 0.33 s
+#: against 0.22 s (0.58 s with the extra runs at the full tolerance)
 SPREAD = 1e-2
 EXTRA_STARTS = 8
 EXTRA_TOL = 1e-4
@@ -280,8 +281,9 @@ def fit(
     polished on all. ``lobes``: 1, or 2 for a second specular lobe (:func:`two_lobe`;
     Lafortune: its own ``lobes``). ``starts``: local optimisations run (from the defaults
     and the best of ``candidates`` random points); where their minima differ in cost by more
-    than :data:`SPREAD`, up to :data:`EXTRA_STARTS` more (``FitResult.starts``: how many ran). ``data``: precomputed :func:`sample` or
-    :func:`table` output (then ``measured`` only names the source).
+    than :data:`SPREAD`, up to :data:`EXTRA_STARTS` more (``FitResult.starts``: how many ran).
+    ``data``: precomputed :func:`sample` or :func:`table` output (then ``measured`` only names
+    the source).
     Returns a :class:`FitResult` (``params`` holds every parameter of the model;
     ``at_bound`` lists the free values that ended on a fitting bound).
     """
@@ -432,4 +434,4 @@ def _plan_starts(packer: ParamPacker, residuals, n_samples: int, seed: int, cand
     order = [0] + [int(i) for i in np.argsort(costs) if i != 0]
     return _StartPlan([cand[i] for i in order[:starts]], const, groups, exact, nfev)
 
-__all__ = ["fit", "EXACT_JACOBIAN", "JOIN_XTOL", "JOIN_RTOL", "SPREAD", "EXTRA_STARTS", "TABLE_SEARCH_SAMPLES", "SERIAL_SAMPLES", "POLISH_ITERATIONS"]
+__all__ = ["fit", "EXACT_JACOBIAN", "JOIN_XTOL", "JOIN_RTOL", "SPREAD", "EXTRA_STARTS", "EXTRA_TOL", "TABLE_SEARCH_SAMPLES", "SERIAL_SAMPLES", "POLISH_ITERATIONS"]
