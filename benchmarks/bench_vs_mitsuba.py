@@ -121,6 +121,20 @@ def _brdfkit_model():
                     alpha=ALPHA, eta=ETA, k=K, kd=0.0, ks=1.0)
 
 
+def _eval_numpy(mi, dr, bsdf, to_dr, ctx, wi32: np.ndarray, wo32: np.ndarray):
+    """Mitsuba's ``bsdf.eval`` of numpy directions (brdfkit's ``wi`` is Mitsuba's light direction, its
+    ``wo`` Mitsuba's ``wi``, toward the viewer), the Dr.Jit result unevaluated."""
+    s = dr.zeros(mi.SurfaceInteraction3f, len(wi32))
+    s.wi = to_dr(wo32)
+    return bsdf.eval(ctx, s, to_dr(wi32))
+
+
+def _rows(a) -> np.ndarray:
+    """A Dr.Jit colour array as numpy ``(n, 3)`` (it converts to ``(3, n)`` or ``(n, 3)`` by version)."""
+    a = np.asarray(a)
+    return a.T if a.shape[0] == 3 and a.shape[-1] != 3 else a
+
+
 def worker_mitsuba(n: int, calls: int, threads: int = 0) -> dict:
     mi, dr, bsdf, to_dr = _mitsuba(threads)
     wi, wo = directions(n)
@@ -139,17 +153,11 @@ def worker_mitsuba(n: int, calls: int, threads: int = 0) -> dict:
         return v
 
     def from_numpy():
-        s = dr.zeros(mi.SurfaceInteraction3f, n)
-        s.wi = to_dr(wo32)
-        v = bsdf.eval(ctx, s, to_dr(wi32))
-        return np.array(v)  # (3, n) or (n, 3) depending on the Dr.Jit version
+        return np.array(_eval_numpy(mi, dr, bsdf, to_dr, ctx, wi32, wo32))
 
     t_kernel, b_kernel = _times(kernel, calls)
     t_numpy, b_numpy = _times(from_numpy, calls)
-    val = np.array(from_numpy())
-    if val.shape[0] == 3 and val.shape[-1] != 3:
-        val = val.T
-    f = val / wi32[:, 2:3]  # remove the cosine of the light direction
+    f = _rows(from_numpy()) / wi32[:, 2:3]  # remove the cosine of the light direction
     return {"kernel_s": t_kernel, "numpy_s": t_numpy, "kernel_best_s": b_kernel, "numpy_best_s": b_numpy,
             "sample": f[:4096].astype(np.float64).tolist()}
 
@@ -176,9 +184,7 @@ def worker_mitsuba_grad(n: int, calls: int, threads: int = 0) -> dict:
     ctx = mi.BSDFContext()
 
     def evaluate():
-        s = dr.zeros(mi.SurfaceInteraction3f, n)
-        s.wi = to_dr(wo32)
-        return bsdf.eval(ctx, s, to_dr(wi32))
+        return _eval_numpy(mi, dr, bsdf, to_dr, ctx, wi32, wo32)
 
     def value():
         return np.array(evaluate())
@@ -200,9 +206,7 @@ def worker_mitsuba_grad(n: int, calls: int, threads: int = 0) -> dict:
     t_rgb, b_rgb = _times(lambda: grads(keys[1:2]), calls)
     t_all, b_all = _times(lambda: grads(keys), calls)
     _, (g,) = grads(keys[:1])
-    g = np.asarray(g)
-    if g.shape[0] == 3 and g.shape[-1] != 3:
-        g = g.T
+    g = _rows(g)
     return {"eval_s": t_eval, "one_s": t_one, "rgb_s": t_rgb, "all_s": t_all, "eval_best_s": b_eval,
             "one_best_s": b_one, "rgb_best_s": b_rgb, "all_best_s": b_all, "sample": (g / wi32[:, 2:3])[:4096].astype(np.float64).tolist()}
 

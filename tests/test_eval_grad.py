@@ -455,6 +455,7 @@ import json, sys
 import numpy as np
 import brdfkit as bk
 from brdfkit.engine import forward, grad
+from brdfkit.geometry import random_unit_vectors
 
 mode, out = sys.argv[1], sys.argv[2]
 m = bk.model("phong", kd=(0.2, 0.3, 0.4), ks=0.5, shininess=30.0)
@@ -469,8 +470,7 @@ if mode == "no-analysis":
         raise AssertionError("the source was analysed again")
     forward._Func.analyse = refuse
 rng = np.random.default_rng(3)
-wi = rng.normal(size=(64, 3)); wi[:, 2] = np.abs(wi[:, 2]); wi /= np.linalg.norm(wi, axis=1)[:, None]
-wo = rng.normal(size=(64, 3)); wo[:, 2] = np.abs(wo[:, 2]); wo /= np.linalg.norm(wo, axis=1)[:, None]
+wi, wo = random_unit_vectors(64, rng), random_unit_vectors(64, rng)
 f, g = m.eval_grad(wi, wo)
 json.loads(path.read_text())  # a valid manifest is on disk afterwards
 np.save(out, np.concatenate([f.ravel()] + [g[k].ravel() for k in sorted(g)]))

@@ -30,9 +30,8 @@ from __future__ import annotations
 
 import threading
 
-import numpy as np
-
 import numba
+import numpy as np
 
 from . import driver as _driver
 from .active import engine
@@ -411,7 +410,7 @@ def _eval_directional(model, kernel, p, c, fi, fo, shape, f32: bool, dirs, n: in
         with _LOCK:
             drive = _directional_driver(kernel, choices, f32, n, off)
     w_i, w_o = _driver.read_only(fi).reshape(-1), _driver.read_only(fo).reshape(-1)
-    out = np.zeros((npairs, 3), dtype=ft)
+    out = np.empty((npairs, 3), dtype=ft)  # written by the first pass, or by eval where there is none
     planes = np.empty((len(groups), npairs, 3), dtype=ft)
     bad = np.zeros(_driver.nchunks(npairs), dtype=np.int64)
     lo2, hi2 = _driver.unit_band(out.dtype, ft)

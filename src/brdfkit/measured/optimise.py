@@ -8,8 +8,9 @@ any isotropic model): its free values (:mod:`brdfkit.measured.packing`) minimise
 
 Optimiser: bounded trust-region reflective least squares (Branch, Coleman & Li 1999) from several
 starts: the parameters' defaults plus the best of a few dozen random points of the bounded
-parameter space (multi-start, so a local minimum does not decide); the best result wins. A
-start that enters the basin of a minimum an earlier start converged to (within
+parameter space (multi-start, so a local minimum does not decide); the best result wins. Where
+those starts end in minima more than :data:`SPREAD` apart in cost, up to :data:`EXTRA_STARTS` more
+run, from the next best candidates. A start that enters the basin of a minimum an earlier start converged to (within
 :data:`JOIN_XTOL` of it in every free value, :data:`JOIN_RTOL` in cost) stops there; its
 ``start_errors`` entry is the error it had then. The Jacobian is the model's exact one, from
 its ``eval_grad`` (:mod:`brdfkit.measured.exact_jacobian`), and the solver
@@ -189,6 +190,7 @@ def _engine_threads(n_samples: int):
 #: against 0.22 s (0.58 s with the extra runs at the full tolerance)
 SPREAD = 1e-2
 EXTRA_STARTS = 8
+#: ``ftol``, ``xtol`` and ``gtol`` of the extra runs (relative, as the fit's own ``tol``, 1e-8)
 EXTRA_TOL = 1e-4
 
 #: Levenberg-Marquardt iterations of the table-scale polish

@@ -98,8 +98,7 @@ def solve(
     scale_inv = np.sqrt(np.diag(G)).copy()
     scale_inv[scale_inv == 0] = 1.0
     v, dv = _coleman_li(x, g, lb, ub)
-    v[dv != 0] *= scale_inv[dv != 0]
-    delta = float(np.linalg.norm(x * scale_inv / np.sqrt(v))) or 1.0
+    delta = float(np.linalg.norm(x * scale_inv / np.sqrt(_scaled(v, dv, scale_inv)))) or 1.0
     alpha = 0.0
     status = None
     while True:
@@ -111,8 +110,7 @@ def solve(
         if status is not None or nfev == max_nfev:
             break
         scale = 1.0 / scale_inv
-        v[dv != 0] *= scale_inv[dv != 0]  # Coleman-Li's distances in the column-scaled variables
-        d = np.sqrt(v) * scale  # x = d · x̂
+        d = np.sqrt(_scaled(v, dv, scale_inv)) * scale  # x = d · x̂
         diag_h = g * dv * scale
         g_h = d * g
         A = G * np.outer(d, d)
@@ -163,6 +161,12 @@ def _coleman_li(x, g, lb, ub) -> tuple[np.ndarray, np.ndarray]:
     v[down] = x[down] - lb[down]
     dv[down] = 1.0
     return v, dv
+
+
+def _scaled(v, dv, scale_inv) -> np.ndarray:
+    """Coleman-Li's distances ``v`` measured in the column-scaled variables (× ``scale_inv``; a
+    variable with no bound ahead keeps 1)."""
+    return np.where(dv != 0, v * scale_inv, v)
 
 
 def _subproblem(lam, V, w, delta: float, alpha: float) -> tuple[np.ndarray, float]:

@@ -76,7 +76,6 @@ ROUTES: dict[tuple[str, str], Handler] = {}
 JSON = "application/json; charset=utf-8"
 TEXT = "text/plain; charset=utf-8"
 MAX_UPLOAD = 64 * 1024 * 1024  # a MERL file is 33 MB
-N_IN = 6
 NBRDF_VEC4 = 211  # u_nbrdf[211] in nbrdf.glsl (nbrdf_blocks)
 
 
@@ -186,7 +185,7 @@ def nbrdf_blocks(fc1, b1, fc2, b2, fc3, b3) -> np.ndarray:
         out[: a.shape[0], : a.shape[1]] = a
         return out
 
-    w1, w2, w3 = pad(fc1, N_IN, 24), pad(fc2, 24, 24), pad(fc3, 24, 4)
+    w1, w2, w3 = pad(fc1, len(fc1), 24), pad(fc2, 24, 24), pad(fc3, 24, 4)
     v1, v2, v3 = pad(np.reshape(b1, (1, -1)), 1, 24)[0], pad(np.reshape(b2, (1, -1)), 1, 24)[0], pad(np.reshape(b3, (1, -1)), 1, 4)[0]
     vec4: list[np.ndarray] = []
     for k in range(6):  # layer 1: columns = inputs 0, 2, 3, 4, then 5, then the bias
