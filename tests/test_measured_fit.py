@@ -306,14 +306,40 @@ def test_starts_that_end_in_different_basins_search_on(monkeypatch):
     data = F.sample("rgl/chm_mint_rgb", n=2000)
     seen = []
     r = F.fit("htsg", "rgl/chm_mint_rgb", data=data, progress=lambda done, total: seen.append((done, total)))
-    assert r.starts == 4 + optimise.EXTRA_STARTS == len(r.start_errors)
+    hops = sum(s.log for s in F.ParamPacker(bk.sources.model_class("htsg")).slots)  # τ: optimise.HOPS
+    assert hops == 1 and r.starts == 4 + optimise.EXTRA_STARTS + hops == len(r.start_errors)
     first = [e * e for e in r.start_errors[:4]]
     assert max(first) > (1 + optimise.SPREAD) * min(first)
     assert r.error < 2.0847 < 0.9 * min(r.start_errors[:4])
     assert seen[:4] == [(i, 4) for i in range(1, 5)] and seen[-1] == (r.starts, r.starts)
     monkeypatch.setattr(optimise, "EXTRA_STARTS", 0)
+    monkeypatch.setattr(optimise, "HOPS", False)
     few = F.fit("htsg", "rgl/chm_mint_rgb", data=data)
     assert few.starts == 4 and few.start_errors == r.start_errors[:4] and few.error > 2.38
     # starts that agree do not search on
     agree = F.fit("ward", "merl/gold-metallic-paint", data=F.sample("merl/gold-metallic-paint", n=800, seed=2))
     assert agree.starts == 4
+
+
+def test_a_log_scale_value_hops_to_its_other_basin(monkeypatch):
+    """Cook-Torrance on merl/blue-metallic-paint2: every start ends with the blue index of refraction
+    at 5.7 (cost 0.020443), but at 49 the cost is 1.1 % lower, behind a ridge; the hop of that value to
+    the far end of its range reaches it (the published table's 0.142231), one run per log-scale value."""
+    from brdfkit.measured import optimise
+
+    data = F.sample("merl/blue-metallic-paint2", n=2000)
+    r = F.fit("cook-torrance", "merl/blue-metallic-paint2", data=data)
+    assert r.error < 0.14224 and r.params["ior"][2] > 20 and r.params["ior"][1] < 5
+    packer = F.ParamPacker(bk.sources.model_class("cook-torrance"))
+    x = packer.x_of(without_hop := {**r.params, "ior": np.array([2.47, 3.03, 5.7])})
+    logs = [i for i, s in enumerate(packer.slots) if s.log]
+    hops = [optimise.decade_hop(packer, x, i) for i in logs]  # each to 20 % of its range from the far end
+    assert [np.flatnonzero(h != x).tolist() for h in hops] == [[i] for i in logs]
+    assert [s.param.name for s in packer.slots if s.log] == ["m"] + ["ior"] * 3
+    assert np.exp(hops[-1][logs[-1]]) == pytest.approx(200 ** 0.8)  # 5.7 is in the lower half: to the upper
+    assert without_hop["m"] < 1e-3 ** 0.5  # m = 0.016, below its range's log middle (0.032): to the upper
+    assert np.exp(hops[0][logs[0]]) == pytest.approx(1e-3 ** 0.2)
+    assert r.starts == 4 + len(hops)  # the four starts agree: no extra starts
+    monkeypatch.setattr(optimise, "HOPS", False)
+    without = F.fit("cook-torrance", "merl/blue-metallic-paint2", data=data)
+    assert without.starts == 4 and without.error > 0.1429 and without.params["ior"][2] < 10
