@@ -17,8 +17,8 @@ in its own fresh process, the rounds alternating:
   ``scipy.optimize.least_squares`` solved every fit; a fit with a model's exact Jacobian is now solved by
   ``brdfkit.measured.trust_region`` and imports no scipy, a fit without one, of a ``.brdf`` file's GLSL,
   still does);
-* the commands: ``brdfkit eval``, ``brdfkit fit`` (both with brdfkit's numba cache warm: each
-  command runs once before the rounds).
+* the commands: ``brdfkit eval``, ``brdfkit fit`` (both with brdfkit's numba cache and Python's
+  bytecode cache warm: each command runs once before the rounds, without ``PYTHONDONTWRITEBYTECODE``).
 
 It prints the medians and each command's time above its floor (what brdfkit's own imports and work
 cost): the fit's above both floors, the numba one (what it pays now) and the numba + scipy.optimize
@@ -83,7 +83,11 @@ def main() -> None:
         floor_probe.write_text(NUMBA_FLOOR.format(probe=""))
         floor_scipy = Path(tmp) / "numba_scipy_floor.py"
         floor_scipy.write_text(NUMBA_FLOOR.format(probe="") + "import scipy.optimize\n")
-        env = dict(os.environ)
+        # as an installed package runs: with its modules' bytecode cached (pip writes it at install; an
+        # editable install writes it at the first import). A machine that sets PYTHONDONTWRITEBYTECODE
+        # (this project's development host does) would otherwise compile brdfkit's sources in every
+        # process, 50-60 ms of each command here; the warm-up below writes the cache.
+        env = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
         env_floor = dict(env, NUMBA_CACHE_DIR=str(Path(tmp) / "numba-cache"))
         py = sys.executable
         bk = _brdfkit()
