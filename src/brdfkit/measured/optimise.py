@@ -205,8 +205,8 @@ EXTRA_TOL = 1e-4
 #: at 49 (the Fresnel curve's grazing rise against its flat metal-like form; 1.1 % lower in cost there,
 #: behind a ridge at 8-12). On the 159 × 9 table (docs/measured.md) they brought the two fits that had
 #: stayed worse than the published table (by 0.53 % and 0.17 %) down to it and 9 more lower by over 0.1 %
-#: (6 Cook-Torrance, 3 Blinn-Phong; up to 1.95 %), the whole table in 163 s against 168 s without them
-#: (this machine's noise exceeds their cost)
+#: (6 Cook-Torrance, 3 Blinn-Phong; up to 1.95 %); the whole table took 142-202 s over five runs with
+#: them, 168 s without (this machine's noise exceeds their cost)
 HOPS = True
 #: where a hop puts the value: this fraction of its (log) range from the far end
 HOP_FRACTION = 0.2
@@ -479,4 +479,4 @@ def _plan_starts(packer: ParamPacker, residuals, n_samples: int, seed: int, cand
     return _StartPlan([cand[i] for i in order[:starts]], const, groups, exact, nfev,
                       max(float(costs.min()), np.finfo(np.float64).tiny))
 
-__all__ = ["fit", "EXACT_JACOBIAN", "JOIN_XTOL", "JOIN_RTOL", "SPREAD", "EXTRA_STARTS", "EXTRA_TOL", "HOPS", "HOP_FRACTION", "TABLE_SEARCH_SAMPLES", "SERIAL_SAMPLES", "POLISH_ITERATIONS"]
+__all__ = ["fit", "EXACT_JACOBIAN", "JOIN_XTOL", "JOIN_RTOL", "SPREAD", "EXTRA_STARTS", "EXTRA_TOL", "HOPS", "HOP_FRACTION", "decade_hop", "TABLE_SEARCH_SAMPLES", "SERIAL_SAMPLES", "POLISH_ITERATIONS"]
