@@ -7,9 +7,16 @@ loop recovers a model's parameters from its own values; bad input raises a one-l
 
 from __future__ import annotations
 
+import sys
+
 import numpy as np
 import pytest
 
+# PyPI's Linux torch brings triton, which torch.optim imports (through torch._dynamo); triton's bundled
+# LLVM segfaults a process into which Mesa's llvmpipe (the OpenGL of the rendering tests that may run
+# earlier in this worker) has already loaded its own LLVM. Torch on the CPU does not need triton: it is
+# hidden here, as uninstalling it would (docs/api.md, "PyTorch").
+sys.modules.setdefault("triton", None)
 torch = pytest.importorskip("torch", reason="PyTorch not installed (the optional extra brdfkit[torch])")
 
 import brdfkit as bk  # noqa: E402
