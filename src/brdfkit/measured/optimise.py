@@ -204,9 +204,9 @@ EXTRA_TOL = 1e-4
 #: each: Cook-Torrance's index of refraction of one channel fits merl/blue-metallic-paint2 both at 5.7 and
 #: at 49 (the Fresnel curve's grazing rise against its flat metal-like form; 1.1 % lower in cost there,
 #: behind a ridge at 8-12). On the 159 × 9 table (docs/measured.md) they brought the two fits that had
-#: stayed worse than the published table (by 0.53 % and 0.17 %) down to it and 9 more lower by over 0.1 %
-#: (6 Cook-Torrance, 3 Blinn-Phong; up to 1.95 %); the whole table took 142-202 s over five runs with
-#: them, 168 s without (this machine's noise exceeds their cost)
+#: stayed worse than commit bbf75cd's published table (by 0.53 % and 0.17 %) down to it and 9 more lower
+#: by over 0.1 % (6 Cook-Torrance, 3 Blinn-Phong; up to 1.95 %); the whole table took 142-202 s over five
+#: runs with them, 168 s without (this machine's noise exceeds their cost)
 HOPS = True
 #: where a hop puts the value: this fraction of its (log) range from the far end
 HOP_FRACTION = 0.2
@@ -443,12 +443,12 @@ class _StartPlan:
     groups: list[list[int]] | None  # channel_groups
     exact: Callable[[np.ndarray], np.ndarray] | None  # exact_jacobian, None where the model has no gradient
     evaluations: int  # residual evaluations spent choosing (counted as before: an upper bound)
-    #: the best candidate's cost Σ r²: the last run from the best minimum (with the exact Jacobian)
-    #: stops on a gradient below ``tol`` times this, as its ftol and xtol are relative. scipy's gtol,
-    #: absolute, had stopped the fits of dark materials (costs of 10⁻⁶) up to 5.7·10⁻⁵ short of the
-    #: minimum in a flat valley; on the 159 × 9 table 3 fits then stayed above the published losses, by
-    #: at most 2.3·10⁻⁷ (55 before, by up to 5.7·10⁻⁵), for 1.6 % more evaluations. Every run at this
-    #: tolerance instead: 9 % more, and gold-metallic-paint's conductor fit 0.36 → 0.52 s
+    #: the best candidate's cost Σ r²: the last run from the best minimum (with the exact Jacobian) stops
+    #: on a gradient below ``tol`` times this, as its ftol and xtol are relative. scipy's gtol, absolute,
+    #: had stopped the fits of dark materials (costs of 10⁻⁶) up to 5.7·10⁻⁵ short of the minimum in a
+    #: flat valley; on the 159 × 9 table 3 fits then stayed above bbf75cd's published losses, by at most
+    #: 2.3·10⁻⁷ (55 before, by up to 5.7·10⁻⁵), for 1.6 % more evaluations. Every run at this tolerance
+    #: instead: 9 % more, and gold-metallic-paint's conductor fit 0.36 → 0.52 s
     cost_scale: float = 1.0
 
 
