@@ -331,13 +331,14 @@ def test_a_log_scale_value_hops_to_its_other_basin(monkeypatch):
     r = F.fit("cook-torrance", "merl/blue-metallic-paint2", data=data)
     assert r.error < 0.14224 and r.params["ior"][2] > 20 and r.params["ior"][1] < 5
     packer = F.ParamPacker(bk.sources.model_class("cook-torrance"))
-    x = packer.x_of(without_hop := {**r.params, "ior": np.array([2.47, 3.03, 5.7])})
+    at_5_7 = {**r.params, "ior": np.array([2.47, 3.03, 5.7])}  # in the basin every start ends in
+    x = packer.x_of(at_5_7)
     logs = [i for i, s in enumerate(packer.slots) if s.log]
     hops = [optimise.decade_hop(packer, x, i) for i in logs]  # each to 20 % of its range from the far end
     assert [np.flatnonzero(h != x).tolist() for h in hops] == [[i] for i in logs]
     assert [s.param.name for s in packer.slots if s.log] == ["m"] + ["ior"] * 3
     assert np.exp(hops[-1][logs[-1]]) == pytest.approx(200 ** 0.8)  # 5.7 is in the lower half: to the upper
-    assert without_hop["m"] < 1e-3 ** 0.5  # m = 0.016, below its range's log middle (0.032): to the upper
+    assert at_5_7["m"] < 1e-3 ** 0.5  # m = 0.016, below its range's log middle (0.032): to the upper
     assert np.exp(hops[0][logs[0]]) == pytest.approx(1e-3 ** 0.2)
     assert r.starts == 4 + len(hops)  # the four starts agree: no extra starts
     monkeypatch.setattr(optimise, "HOPS", False)

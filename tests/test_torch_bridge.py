@@ -12,10 +12,10 @@ import sys
 import numpy as np
 import pytest
 
-# PyPI's Linux torch brings triton, which torch.optim imports (through torch._dynamo); triton's bundled
-# LLVM segfaults a process into which Mesa's llvmpipe (the OpenGL of the rendering tests that may run
-# earlier in this worker) has already loaded its own LLVM. Torch on the CPU does not need triton: it is
-# hidden here, as uninstalling it would (docs/api.md, "PyTorch").
+# PyPI's Linux torch brings triton, which a torch.optim optimiser imports when it is built (through
+# torch._dynamo); triton's bundled LLVM segfaults a process into which Mesa's llvmpipe (the OpenGL of
+# the rendering tests that may run earlier in this worker) has already loaded its own LLVM. Torch on
+# the CPU does not need triton: it is hidden here, as uninstalling it would (docs/api.md, "PyTorch").
 sys.modules.setdefault("triton", None)
 torch = pytest.importorskip("torch", reason="PyTorch not installed (the optional extra brdfkit[torch])")
 

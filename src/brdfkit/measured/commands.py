@@ -124,7 +124,7 @@ def register(app: typer.Typer) -> None:
                                              "and NAME:k=v[:k=v] fixes options of that column"),
         param: List[str] = typer.Option([], "--param", "-p", help="hold a parameter fixed: name=value (repeatable)"),
         metric: str = typer.Option("ngan", "--metric", help="ngan (cosine-weighted RMS), l2, log or cbrt"),
-        starts: int = typer.Option(4, "--starts", help="local optimisations (multi-start; up to 8 more where their minima differ by over 1 %)"),
+        starts: int = typer.Option(4, "--starts", help="local optimisations (multi-start; more where their minima disagree, and one per log-scale value)"),
         samples: str = typer.Option("3000", "--samples", help="measured samples used for fitting, or 'table' (every bin)"),
         lobes: int = typer.Option(1, "--lobes", help="1, or 2 for a second specular lobe (Ngan et al. 2005)"),
         seed: int = typer.Option(0, "--seed", help="random seed of the sampling and the starts"),

@@ -206,9 +206,12 @@ EXTRA_TOL = 1e-4
 #: behind a ridge at 8-12). On the 159 × 9 table (docs/measured.md) they brought the two fits that had
 #: stayed worse than commit bbf75cd's published table (by 0.53 % and 0.17 %) down to it and 9 more lower
 #: by over 0.1 % (6 Cook-Torrance, 3 Blinn-Phong; up to 1.95 %); the whole table took 142-202 s over five
-#: runs with them, 168 s without (this machine's noise exceeds their cost)
+#: runs with them, 168 s without (this machine's noise exceeds their cost). A hop is basin hopping
+#: (Wales & Doye, J. Phys. Chem. A 101, 5111, 1997: perturb, minimise locally, keep the lower minimum)
+#: with the perturbation along one coordinate, across its decades
 HOPS = True
-#: where a hop puts the value: this fraction of its (log) range from the far end
+#: where a hop puts the value: this fraction (dimensionless, in (0, ½)) of its range in the optimiser's
+#: log coordinate, measured from the end farther from it
 HOP_FRACTION = 0.2
 
 #: Levenberg-Marquardt iterations of the table-scale polish
@@ -335,17 +338,20 @@ def fit(
     start_errors: list[float] = []
     known: list[tuple[np.ndarray, float]] = []  # the minima the starts converged to
     with fit_progress(progress, f"fit {cls.name} ← {data.source}", total) as step:
-        def run(x0: np.ndarray, tol_run: float = tol) -> None:
-            nonlocal nfev, best_x, best_cost, best_done
+        def local(x0: np.ndarray, tol_run: float, known_minima=(), cost_scale: float = 1.0):
+            """One local run from ``x0`` (:func:`_local`), its evaluations counted in ``nfev``."""
+            nonlocal nfev
             with _engine_threads(len(search)):
-                x, cst, used, joined, done = _local(residuals, x0, packer, max_nfev or 100, tol_run, known,
-                                                    plan.const, plan.groups, plan.exact)
-            nfev += used
+                out = _local(residuals, x0, packer, max_nfev or 100, tol_run, known_minima, plan.const,
+                             plan.groups, plan.exact, cost_scale)
+            nfev += out[2]
+            return out
+
+        def run(x0: np.ndarray, tol_run: float = tol) -> None:
+            nonlocal best_x, best_cost, best_done
+            x, cst, _, joined, done = local(x0, tol_run, known)
             if tol_run > tol and cst < best_cost:  # a rough run found a deeper basin: converge in it
-                with _engine_threads(len(search)):
-                    x, cst, used, joined, done = _local(residuals, x, packer, max_nfev or 100, tol, (),
-                                                        plan.const, plan.groups, plan.exact)
-                nfev += used
+                x, cst, _, joined, done = local(x, tol)
             start_errors.append(math.sqrt(cst))
             if not joined:
                 known.append((x, cst))
@@ -372,10 +378,7 @@ def fit(
             # (gold-metallic-paint's microfacet fit stopped 2.8e-6 above the minimum, in cost, that
             # other starts reached, and later starts that joined its basin stopped there), and, with
             # the exact Jacobian, to a gradient tolerance relative to the fit's cost (cost_scale)
-            with _engine_threads(len(search)):
-                x, cst, used, _, _ = _local(residuals, best_x, packer, 100, tol, (), plan.const, plan.groups,
-                                            plan.exact, plan.cost_scale)
-            nfev += used
+            x, cst, _, _, _ = local(best_x, tol, cost_scale=plan.cost_scale)
             if cst < best_cost:
                 best_cost, best_x = cst, x
         if search is not data:  # polish the best start on every bin

@@ -38,17 +38,17 @@ def fit_progress(progress: bool | Callable[[int, int], None], title: str, total:
     every step, or ``False`` for neither. The bar is taken down on leaving, also on an error."""
     callback = progress if callable(progress) else None
     shown = _bar(title, total, unit) if progress is True else None
-    steps = [total]
 
     def step(done: int) -> None:
         if shown is not None:
             shown[0].update(shown[1], advance=1)
         if callback is not None:
-            callback(done, steps[0])
+            callback(done, total)
 
     def grow(new_total: int) -> None:
         """More steps than announced (a fit that searches on): the bar's and the callback's total."""
-        steps[0] = new_total
+        nonlocal total
+        total = new_total
         if shown is not None:
             shown[0].update(shown[1], total=new_total)
 

@@ -90,7 +90,6 @@ def solve(
     f = np.asarray(fun(x), np.float64)
     if not np.all(np.isfinite(f)):
         raise ValueError("the residuals are not finite at the initial point")
-    m = f.size
     nfev, njev = 1, 1
     Jt = np.asarray(jac_t(x), np.float64)
     cost = 0.5 * float(f @ f)
