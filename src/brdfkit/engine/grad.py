@@ -319,9 +319,10 @@ def eval_grad(model, wi, wo, wrt=None):
     npairs = fi.shape[0]
     f32 = dtype == np.float32 and getattr(type(model), "kernel_float32", True) and fits_float32(p)
     ft = np.float32 if f32 else np.float64
-    if npairs and wrt is not None and engine() == "compiled" and np.dtype(dtype) == ft:
+    if npairs and wrt is not None and engine() == "compiled":
         # a few derivatives asked for by name: vectorised directional passes (f then to the last bit
-        # of eval's: the vectorised loop may call the vector math library where eval's scalar loop calls libm)
+        # of eval's: the vectorised loop may call the vector math library where eval's scalar loop calls libm);
+        # float32 arrays of a model whose kernel has no float32 twin run them in float64, rounded once
         try:
             total = sum(s for _, _, s in full)
             # microfacet's alpha with both axes asked for too: their sum, no pass of its own
@@ -329,7 +330,8 @@ def eval_grad(model, wi, wo, wrt=None):
             dirs = _directions(full, [k for k in names if not (summed and k == "alpha")])
             if len(dirs) <= DIRECTIONAL_MAX:
                 groups, touched = passes(dirs, forward_kernel(kernel, total)[1])
-                f, grads = _eval_directional(model, kernel, p, c, fi, fo, shape, f32, dirs, total, groups, touched)
+                f, grads = _eval_directional(model, kernel, p, c, fi, fo, shape, f32, dirs, total, groups, touched,
+                                             np.dtype(dtype))
                 if summed:
                     grads["alpha"] = grads["alpha_x"] + grads["alpha_y"]
                 return f, {k: grads[k] for k in names}
@@ -348,17 +350,11 @@ def eval_grad(model, wi, wo, wrt=None):
             pt = _driver.param_tuple(p, ft)
             w_i, w_o = _driver.read_only(fi), _driver.read_only(fo)
             bad = np.zeros(_driver.nchunks(npairs), dtype=np.int64)
-            if out.dtype != ft:  # float32 arrays through the float64 kernel: computed in float64, rounded once
-                o64 = np.zeros((npairs, 3))
-                g64 = np.zeros((npairs, 3, n))
-                lo2, hi2 = _driver.unit_band(out.dtype, np.float64)
-                _run(drive, w_i.astype(np.float64), w_o.astype(np.float64), pt, o64, g64, lim, lo2, hi2, bad, npairs)
-                out[...] = np.minimum(o64, lim)
-                with np.errstate(over="ignore"):  # a derivative beyond float32's range is ±inf (module docstring)
-                    gout[...] = np.where(o64[..., None] < lim, g64, 0.0)
-            else:
-                lo2, hi2 = _driver.unit_band(out.dtype, ft)
-                _run(drive, w_i, w_o, pt, out, gout, ft(lim), lo2, hi2, bad, npairs)
+            # float32 arrays through the float64 kernel: computed in float64, rounded once as the driver
+            # stores into them (f at most float32's largest value, a derivative beyond its range ±inf)
+            lo2, hi2 = _driver.unit_band(out.dtype, ft)
+            _run(drive, w_i.astype(ft, copy=False), w_o.astype(ft, copy=False), pt, out, gout, ft(lim), lo2, hi2,
+                 bad, npairs)
             if bad.any():  # some length outside the safe band: the exact check (raises where one is not unit)
                 check_unit_flat(name, fi, fo, dtype)
         else:
@@ -396,11 +392,15 @@ def _scatter(planes, src, gout):
                 gout[j, c, k] = planes[g, j, c] if g >= 0 else zero
 
 
-def _eval_directional(model, kernel, p, c, fi, fo, shape, f32: bool, dirs, n: int, groups, touched):
+def _eval_directional(model, kernel, p, c, fi, fo, shape, f32: bool, dirs, n: int, groups, touched, dtype):
     """``eval_grad`` by vectorised directional passes (:data:`DIRECTIONAL_TEMPLATE`), one per group of
     :func:`passes`, along the sum of its derivatives' directions: ``f`` and, per entry of ``dirs``, its
     derivative — the pass's plane in the channels it reaches (no other derivative of the group reaches
-    them), 0 in the others. An RGB parameter's derivative is ``(..., 3, 3)``, ``[..., channel_out, channel_in]``."""
+    them), 0 in the others. An RGB parameter's derivative is ``(..., 3, 3)``, ``[..., channel_out, channel_in]``.
+    ``dtype`` is the arrays' (the result's); where it is float32 and ``f32`` is False (a kernel without a
+    float32 twin, parameters beyond float32) the passes run in float64 and their results are rounded once,
+    as the driver stores them, as the many-tangent route does: f at most float32's largest value, the
+    derivatives 0 where f reaches it and ±inf beyond float32's range (the module docstring)."""
     ft = np.float32 if f32 else np.float64
     npairs = fi.shape[0]
     choices = tuple(int(v) for v in c)
@@ -409,20 +409,20 @@ def _eval_directional(model, kernel, p, c, fi, fo, shape, f32: bool, dirs, n: in
     if groups:
         with _LOCK:
             drive = _directional_driver(kernel, choices, f32, n, off)
-    w_i, w_o = _driver.read_only(fi).reshape(-1), _driver.read_only(fo).reshape(-1)
-    out = np.empty((npairs, 3), dtype=ft)  # written by the first pass, or by eval where there is none
-    planes = np.empty((len(groups), npairs, 3), dtype=ft)
+    w_i, w_o = (_driver.read_only(w.astype(ft, copy=False)).reshape(-1) for w in (fi, fo))
+    out = np.empty((npairs, 3), dtype=dtype)  # written by the first pass, or by eval where there is none
+    planes = np.empty((len(groups), npairs, 3), dtype=dtype)
     bad = np.zeros(_driver.nchunks(npairs), dtype=np.int64)
-    lo2, hi2 = _driver.unit_band(out.dtype, ft)
-    lim = ft(np.finfo(ft).max)
+    lo2, hi2 = _driver.unit_band(dtype, ft)
+    lim = ft(np.finfo(dtype).max)
     if not groups:  # nothing reaches f: f itself, by eval's driver
-        out[...] = np.asarray(model.eval(fi, fo), dtype=ft)
+        out[...] = model.eval(fi, fo)
     for g, members in enumerate(groups):
         v = sum(dirs[i][2] for i in members)
         pt = _driver.param_tuple(np.concatenate([p, v]), ft)
         _run(drive, w_i, w_o, pt, out.reshape(-1), planes[g].reshape(-1), lim, lo2, hi2, bad, npairs)
         if g == 0 and bad.any():  # some length outside the safe band: the exact check
-            check_unit_flat(model.name, fi, fo, out.dtype)
+            check_unit_flat(model.name, fi, fo, dtype)
     grads: dict[str, np.ndarray] = {}
     # a scalar parameter's derivative alone in its pass is that pass's plane (the twin stores 0 in the
     # channels it does not reach); the others are laid out by one parallel scatter, a column each in
@@ -437,7 +437,7 @@ def _eval_directional(model, kernel, p, c, fi, fo, shape, f32: bool, dirs, n: in
         for col, i in enumerate(rest):
             for c_out in touched[i]:
                 src[c_out, col] = group_of[i]
-        gout = np.empty((npairs, 3, len(rest)), dtype=ft)
+        gout = np.empty((npairs, 3, len(rest)), dtype=dtype)
         with _driver.may_compile((_scatter, planes.dtype)):
             _scatter(planes, src, gout)
         block = gout.reshape(shape + (len(rest),))
@@ -458,7 +458,7 @@ def _run(drive, wi, wo, pt, out, gout, lim, lo2, hi2, bad, npairs) -> None:
     from . import vecmath
     if npairs <= _driver.CHUNK:
         drive = getattr(sys.modules[drive.py_func.__module__], "drive_serial", drive)
-    with _driver.may_compile(_driver._compile_key(drive, pt, wi, wo)), vecmath.compiling():
+    with _driver.may_compile(_driver._compile_key(drive, pt, wi, wo, out)), vecmath.compiling():
         drive(wi, wo, pt, out, gout, lim, lo2, hi2, bad)
 
 
