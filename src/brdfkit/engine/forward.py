@@ -71,8 +71,8 @@ _MATH_UNARY = {
     # name: derivative as a source template in x (the argument) and r (the result). Where the derivative is
     # infinite (acos at ±1, log at 0) the rule gives the IEEE infinity instead of dividing by zero, which
     # raises in Python (the reference engine) and gives inf in numba: both engines then compute the same
-    # tangent (inf · 0 = nan where a zero tangent meets it, dropped when it only feeds floor/int/a comparison,
-    # as in htsg_series.thinning_step).
+    # tangent; a zero tangent that meets it stays 0 (_UNBOUNDED_RULES), and an infinite tangent that only
+    # feeds floor/int/a comparison is dropped, as in htsg_series.thinning_step.
     "sqrt": "(0.5 / r if r > 0.0 else 0.0)",
     "exp": "r",
     "log": "(1.0 / x if x != 0.0 else math.inf)",
@@ -94,6 +94,10 @@ _MATH_UNARY = {
     "ceil": None,
     "trunc": None,
 }
+#: the rules above that are infinite somewhere or overflow near it (1/x, 0.5/√x of a subnormal x): their
+#: twin multiplies only a nonzero tangent by them (a zero one stays 0: ln d of a subnormal d along a
+#: direction that does not move d, Lafortune's ∂/∂C_y where u_y v_y = 0)
+_UNBOUNDED_RULES = frozenset({"sqrt", "log", "log1p", "asin", "acos"})
 
 
 class _Func:
@@ -614,10 +618,13 @@ class _Func:
             rule = _MATH_UNARY[fname]
             x = vals[0]
             g = self.tmp()
-            lines.append(f"{g} = " + rule.replace("x", x).replace("r", t) if False else
-                         f"{g} = {_subst(rule, x, t)}")
+            lines.append(f"{g} = {_subst(rule, x, t)}")
             for j in keys:
-                lines.append(f"{t}__d{j} = {g} * {ders[0][j]}")
+                dx = ders[0][j]
+                # a rule that can be infinite (or overflow: 1/x of a subnormal x) meets a zero tangent as 0,
+                # the derivative along a direction that does not move x, not as inf · 0 = nan
+                lines.append(f"{t}__d{j} = ({g} * {dx} if {dx} != 0.0 else 0.0)" if fname in _UNBOUNDED_RULES else
+                             f"{t}__d{j} = {g} * {dx}")
                 d_out[j] = f"{t}__d{j}"
             return lines, t, d_out
         if fname in ("pow", "atan2", "hypot", "copysign") and len(vals) == 2:

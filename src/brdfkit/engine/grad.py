@@ -135,8 +135,11 @@ DIRECTIONAL_MAX = 4
 _LOCK = threading.Lock()
 
 
-def _stores(rets, col: dict) -> str:
-    """The stores of one pair's results: ``col`` maps a seeded component of ``p`` to its column of ``gout``."""
+def _stores(rets, col: dict, summed: tuple = ()) -> str:
+    """The stores of one pair's results: ``col`` maps a seeded component of ``p`` to its column of ``gout``;
+    ``summed`` is empty or ``(column, components)``: a column storing the sum of those components'
+    tangents, added in the working precision before the store (microfacet's ``alpha``, ``alpha_x + alpha_y``:
+    summed after a float32 store, two derivatives beyond float32's range of opposite signs gave inf − inf = NaN)."""
     lines = []
     k = 0
     for ch, pat in enumerate(rets):
@@ -145,6 +148,10 @@ def _stores(rets, col: dict) -> str:
         lines.append(f"        out[j, {ch}] = min(v{ch}, lim) if ok else ZERO")
         for i, comp in enumerate(sorted(pat)):
             lines.append(f"        gout[j, {ch}, {col[comp]}] = res[{k + 1 + i}] if keep{ch} else ZERO")
+        if summed:
+            scol, comps = summed
+            terms = [f"res[{k + 1 + i}]" for i, comp in enumerate(sorted(pat)) if comp in comps]
+            lines.append(f"        gout[j, {ch}, {scol}] = ({' + '.join(terms) or 'ZERO'}) if keep{ch} else ZERO")
         k += 1 + len(pat)
     return "\n".join(lines)
 
@@ -196,12 +203,14 @@ def _source(template: str, kernel, twin, choices: tuple, f32: bool, stem: str, *
     return f"{stem}_{key}{'__f32' if f32 else ''}__c" + "_".join(str(v) for v in choices), src
 
 
-def _grad_driver(kernel, choices: tuple, f32: bool, seeds: tuple):
+def _grad_driver(kernel, choices: tuple, f32: bool, seeds: tuple, summed: tuple = ()):
+    """The many-tangent driver of ``kernel``'s twin seeded by ``seeds`` (the components of ``p``, a column of
+    ``gout`` each, in order), and ``summed``'s column if any (:func:`_stores`)."""
     twin, rets = forward_kernel(kernel, seeds)
-    stem, src = _source(GRAD_TEMPLATE, kernel, twin, choices, f32, "grad", what="", npairs="wi.shape[0]",
-                        stores=_stores(rets, {k: i for i, k in enumerate(seeds)}))
+    stem, src = _source(GRAD_TEMPLATE, kernel, twin, choices, f32, "grad_sum" if summed else "grad", what="",
+                        npairs="wi.shape[0]", stores=_stores(rets, {k: i for i, k in enumerate(seeds)}, summed))
     py = getattr(kernel, "py_func", kernel)
-    return _load(("grad", py.__module__, py.__name__, seeds, f32, choices), stem[:200], src)
+    return _load(("grad", py.__module__, py.__name__, seeds, f32, choices, summed), stem[:200], src)
 
 
 def _directional_stores(rets) -> str:
@@ -325,20 +334,22 @@ def eval_grad(model, wi, wo, wrt=None):
         # float32 arrays of a model whose kernel has no float32 twin run them in float64, rounded once
         try:
             total = sum(s for _, _, s in full)
-            # microfacet's alpha with both axes asked for too: their sum, no pass of its own
-            summed = "alpha" in names and {"alpha_x", "alpha_y"} <= set(names)
-            dirs = _directions(full, [k for k in names if not (summed and k == "alpha")])
+            # microfacet's alpha: a pass along e_x + e_y of its own, also beside both axes (their sum after
+            # the store could be inf − inf where the two are beyond float32's range with opposite signs)
+            dirs = _directions(full, names)
             if len(dirs) <= DIRECTIONAL_MAX:
                 groups, touched = passes(dirs, forward_kernel(kernel, total)[1])
                 f, grads = _eval_directional(model, kernel, p, c, fi, fo, shape, f32, dirs, total, groups, touched,
                                              np.dtype(dtype))
-                if summed:
-                    grads["alpha"] = grads["alpha_x"] + grads["alpha_y"]
                 return f, {k: grads[k] for k in names}
         except Unsupported as e:
             raise ValueError(f"{name}: no gradient ({e})") from None
+    # microfacet's alpha sets both axes: its derivative, the sum of theirs, is a column of its own, summed
+    # in the working precision (:func:`_stores`)
+    where = {k: off for k, off, _ in full}
+    alpha_sum = (n, (where["alpha_x"], where["alpha_y"])) if "alpha" in names else ()
     out = np.zeros((npairs, 3), dtype=dtype)
-    gout = np.zeros((npairs, 3, n), dtype=dtype)
+    gout = np.zeros((npairs, 3, n + bool(alpha_sum)), dtype=dtype)
     lim = float(np.finfo(dtype).max)
     try:
         if npairs == 0:
@@ -346,7 +357,7 @@ def eval_grad(model, wi, wo, wrt=None):
         elif engine() == "compiled":
             choices = tuple(int(v) for v in c)
             with _LOCK:
-                drive = _grad_driver(kernel, choices, f32, seeds)
+                drive = _grad_driver(kernel, choices, f32, seeds, alpha_sum)
             pt = _driver.param_tuple(p, ft)
             w_i, w_o = _driver.read_only(fi), _driver.read_only(fo)
             bad = np.zeros(_driver.nchunks(npairs), dtype=np.int64)
@@ -360,21 +371,24 @@ def eval_grad(model, wi, wo, wrt=None):
         else:
             check_unit_flat(name, fi, fo, dtype)
             o64 = np.zeros((npairs, 3))
-            g64 = np.zeros((npairs, 3, n))
-            _reference(kernel, seeds, fi, fo, p, c, o64, g64, lim)
+            g64 = np.zeros((npairs, 3, gout.shape[2]))
+            _reference(kernel, seeds, fi, fo, p, c, o64, g64[..., :n], lim)
+            if alpha_sum:
+                g64[..., n] = g64[..., seeds.index(where["alpha_x"])] + g64[..., seeds.index(where["alpha_y"])]
             out[...] = o64
-            gout[...] = g64
+            with np.errstate(over="ignore"):  # a derivative beyond float32's range is ±inf
+                gout[...] = g64
     except Unsupported as e:
         raise ValueError(f"{name}: no gradient ({e})") from None
     f = out.reshape(shape)
-    g = gout.reshape(shape + (n,))
+    g = gout.reshape(shape + gout.shape[2:])
     grads = {}
     col = 0
     for pname, _, size in lay:
         grads[pname] = g[..., col] if size == 1 else g[..., col:col + size]
         col += size
-    if "alpha" in names:
-        grads["alpha"] = grads["alpha_x"] + grads["alpha_y"]  # alpha sets both
+    if alpha_sum:
+        grads["alpha"] = g[..., n]
     return f, {k: grads[k] for k in names}
 
 

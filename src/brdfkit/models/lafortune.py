@@ -77,10 +77,20 @@ def generalized_dot_c(ux, uy, uz, vx, vy, vz, cx, cy, cz):
 
 @jit
 def cosine_lobe_c(d, n):
-    """``max(0, d)^n`` (eq. 4; 0 where ``d <= 0``, also for n = 0), as ``exp(min(n·ln d, LOG_CAP))``."""
+    """``max(0, d)^n`` (eq. 4; 0 where ``d <= 0``, also for n = 0), as ``exp(min(n·ln d, LOG_CAP))``.
+
+    Two cases are written for the derivatives (issue 31: the forward twin differentiates this source),
+    with the same values: where ``d^n`` underflows to 0 the result is the constant 0 (derivatives 0,
+    not 0·inf = NaN when ``d`` is subnormal and ``∂ ln d = ∂d/d`` overflows); at n = 0, the range's end,
+    it is ``1 + n·ln(max(d, 1e-150))`` = 1, so ``∂/∂n = ln d`` (d floored at 1e-150, 1e-19 in the float32
+    twin) and the other derivatives 0 (not 0·inf).
+    """
     if d <= 0.0:
         return 0.0
-    return math.exp(min(n * math.log(d), LOG_CAP))
+    if n == 0.0:
+        return 1.0 + n * math.log(max(d, 1e-150))
+    v = math.exp(min(n * math.log(d), LOG_CAP))
+    return v if v > 0.0 else 0.0
 
 
 @jit(inline=True)

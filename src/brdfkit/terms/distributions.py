@@ -72,6 +72,7 @@ import math
 import numpy as np
 
 from ..engine import jit, vectorize
+from ..geometry import NORMAL_MIN
 
 _SQRT_PI = math.sqrt(math.pi)
 
@@ -152,11 +153,24 @@ def projected_slope(wx, wy, ax, ay):
 
 
 @jit
+def lambda_floor(wz):
+    """``w_z`` for Smith's Λ: a subnormal ``w_z`` (below 2.2e-308; 1.2e-38 in a float32 twin) raised to the
+    smallest normal number. Λ ~ α(w)/(2 w_z) (GGX; Beckmann /√π more) grows without bound as w_z → 0, and so does its derivative
+    with respect to α: from a subnormal w_z both overflowed, and ``G = 1/(1 + Λi + Λo)``'s derivative
+    came out as inf·0 = NaN (issue 31's gradients). With the floor Λ and its derivative stay below
+    2.3e307 (float32: 4.3e37) for α ≤ 1, twice that summed; the value changes only where G1 ≈ 1/Λ is
+    already at the bottom of the float range. ``w_z <= 0`` passes through (Λ = +inf there)."""
+    return max(wz, NORMAL_MIN) if wz > 0.0 else wz
+
+
+@jit
 def lambda_beckmann(wx, wy, wz, ax, ay):
     """Exact Smith Λ of Beckmann: ``a = w_z/s``, ``Λ = (exp(−a²)/(a√π) − erfc(a))/2`` (Walter 2007, eq. 27; Heitz 2014, eq. 72).
 
-    0 at normal incidence (s = 0), +inf for ``w_z <= 0``, never NaN or negative.
+    0 at normal incidence (s = 0), +inf for ``w_z <= 0``, never NaN or negative. A subnormal ``w_z``
+    counts as the smallest normal number (:func:`lambda_floor`).
     """
+    wz = lambda_floor(wz)
     s = projected_slope(wx, wy, ax, ay)
     # computed for every direction, the cases selected after (no branch around erfc: a loop over
     # this function vectorises, erfc included, see brdfkit.engine.vecmath); guarded divisions
@@ -186,9 +200,10 @@ def lambda_ggx_parts(wx, wy, wz, ax, ay):
 def lambda_ggx(wx, wy, wz, ax, ay):
     """Exact Smith Λ of GGX, ``(−1 + sqrt(1 + s²/w_z²))/2`` as ``s²/(2 w_z (sqrt(w_z² + s²) + w_z))`` (Walter 2007, eq. 34).
 
-    0 at normal incidence, +inf for ``w_z <= 0``; no cancellation.
+    0 at normal incidence, +inf for ``w_z <= 0``; no cancellation. A subnormal ``w_z`` counts as the
+    smallest normal number (:func:`lambda_floor`).
     """
-    num, den = lambda_ggx_parts(wx, wy, wz, ax, ay)
+    num, den = lambda_ggx_parts(wx, wy, lambda_floor(wz), ax, ay)
     if den <= 0.0:
         return math.inf  # below the horizon, or the denominator underflowed: fully masked, G1 = 0
     return num / den
@@ -364,6 +379,7 @@ __all__ = [
     "d_ggx",
     "projected_slope",
     "lambda_beckmann",
+    "lambda_floor",
     "lambda_ggx",
     "lambda_ggx_parts",
     "d_of",

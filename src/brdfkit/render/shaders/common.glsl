@@ -277,10 +277,15 @@ float projected_roughness_tan(vec3 w, float ax, float ay) {
 
 // Exact Smith Λ of Beckmann, for w.z > 0 (Walter et al. 2007, eq. 27; Heitz 2014, eq. 72):
 // a = w_z / s, Λ = (exp(−a²)/(a √π) − erfc(a)) / 2, clamped at 0; Λ = 0 for s = 0.
+// A subnormal w.z counts as the smallest normal float (terms/distributions.py: lambda_floor).
+float bk_lambda_floor(float z) {
+    return z > 0.0 ? max(z, 1.17549435e-38) : z;
+}
+
 float beckmann_lambda(vec3 w, float ax, float ay) {
     float s = projected_roughness_tan(w, ax, ay);
     if (s <= 0.0) return 0.0;
-    float a = w.z / s;
+    float a = bk_lambda_floor(w.z) / s;
     float lam = 0.5 * (exp(-a * a) / (a * 1.77245385090551602730) - bk_erfc_pos(a));
     return max(lam, 0.0);
 }
@@ -289,7 +294,8 @@ float beckmann_lambda(vec3 w, float ax, float ay) {
 // (−1 + sqrt(1 + α² tan²θ))/2 evaluated as s² / (2 w_z (sqrt(w_z² + s²) + w_z)).
 float ggx_lambda(vec3 w, float ax, float ay) {
     float s = projected_roughness_tan(w, ax, ay);
-    return (s * s) / (2.0 * w.z * (sqrt(w.z * w.z + s * s) + w.z));
+    float z = bk_lambda_floor(w.z);
+    return (s * s) / (2.0 * z * (sqrt(z * z + s * s) + z));
 }
 
 float microfacet_lambda(int dist, vec3 w, float ax, float ay) {
