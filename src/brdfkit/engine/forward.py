@@ -98,6 +98,10 @@ _MATH_UNARY = {
 #: twin multiplies only a nonzero tangent by them (a zero one stays 0: ln d of a subnormal d along a
 #: direction that does not move d, Lafortune's ∂/∂C_y where u_y v_y = 0)
 _UNBOUNDED_RULES = frozenset({"sqrt", "log", "log1p", "asin", "acos"})
+#: the rules above that are 1/(an expression in x): the twin divides the tangent by it instead of
+#: multiplying by its reciprocal, which overflows first (ln d of a subnormal d: 1/d = inf where
+#: ∂d/d is ~1e300, Lafortune's lobe d^n = exp(n ln d) with C_z = 1e-300 at a grazing pair)
+_QUOTIENT_RULES = {"log": "x", "log1p": "(1.0 + x)"}
 
 
 class _Func:
@@ -617,6 +621,14 @@ class _Func:
         if fname in _MATH_UNARY and len(vals) == 1:
             rule = _MATH_UNARY[fname]
             x = vals[0]
+            if fname in _QUOTIENT_RULES:  # dx / x: one rounding, and finite where 1/x alone overflows
+                den = _subst(_QUOTIENT_RULES[fname], x, t)
+                for j in keys:
+                    dx = ders[0][j]
+                    lines.append(f"{t}__d{j} = (({dx} / {den} if {den} != 0.0 else math.copysign(math.inf, {dx}))"
+                                 f" if {dx} != 0.0 else 0.0)")
+                    d_out[j] = f"{t}__d{j}"
+                return lines, t, d_out
             g = self.tmp()
             lines.append(f"{g} = {_subst(rule, x, t)}")
             for j in keys:
