@@ -71,8 +71,8 @@ _MATH_UNARY = {
     # name: derivative as a source template in x (the argument) and r (the result). Where the derivative is
     # infinite (acos at ±1, log at 0) the rule gives the IEEE infinity instead of dividing by zero, which
     # raises in Python (the reference engine) and gives inf in numba: both engines then compute the same
-    # tangent; a zero tangent that meets it stays 0 (_UNBOUNDED_RULES), and an infinite tangent that only
-    # feeds floor/int/a comparison is dropped, as in htsg_series.thinning_step.
+    # tangent; a zero tangent that meets it stays 0 (_QUOTIENT_RULES, _UNBOUNDED_RULES), and an infinite
+    # tangent that only feeds floor/int/a comparison is dropped, as in htsg_series.thinning_step.
     "sqrt": "(0.5 / r if r > 0.0 else 0.0)",
     "exp": "r",
     "log": "(1.0 / x if x != 0.0 else math.inf)",
@@ -94,14 +94,14 @@ _MATH_UNARY = {
     "ceil": None,
     "trunc": None,
 }
-#: the rules above that are infinite somewhere or overflow near it (1/x, 0.5/√x of a subnormal x): their
-#: twin multiplies only a nonzero tangent by them (a zero one stays 0: ln d of a subnormal d along a
-#: direction that does not move d, Lafortune's ∂/∂C_y where u_y v_y = 0)
-_UNBOUNDED_RULES = frozenset({"sqrt", "log", "log1p", "asin", "acos"})
 #: the rules above that are 1/(an expression in x): the twin divides the tangent by it instead of
 #: multiplying by its reciprocal, which overflows first (ln d of a subnormal d: 1/d = inf where
-#: ∂d/d is ~1e300, Lafortune's lobe d^n = exp(n ln d) with C_z = 1e-300 at a grazing pair)
+#: ∂d/d is ~1e300, Lafortune's lobe d^n = exp(n ln d) with C_z = 1e-300 at a grazing pair), and a zero
+#: tangent stays 0 (Lafortune's ∂/∂C_y where u_y v_y = 0 at a subnormal d: not 0 · inf)
 _QUOTIENT_RULES = {"log": "x", "log1p": "(1.0 + x)"}
+#: the other rules above that are infinite somewhere or overflow near it (0.5/√x of a subnormal x, asin
+#: and acos at ±1): their twin multiplies only a nonzero tangent by them, a zero one stays 0
+_UNBOUNDED_RULES = frozenset({"sqrt", "asin", "acos"})
 
 
 class _Func:
