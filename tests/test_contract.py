@@ -203,6 +203,21 @@ def random_pairs(seed: int, n: int = 128) -> tuple[np.ndarray, np.ndarray]:
     return wi, wo
 
 
+def drawn_pairs(seed: int, extra=(), grazing=()) -> tuple[np.ndarray, np.ndarray]:
+    """The pairs of one hypothesis example: :func:`random_pairs` (64), ``extra`` pairs of spherical angles
+    ``(θi, φi, θo, φo)`` in degrees, ``grazing`` pairs ``(φi, φo, e)`` with both directions at elevation
+    10^e (issue 31), and the special pairs."""
+    wi, wo = random_pairs(seed, 64)
+    if len(extra):
+        e = np.array(extra)
+        wi = np.concatenate([wi, [_sph(a, b) for a, b in e[:, :2]]])
+        wo = np.concatenate([wo, [_sph(a, b) for a, b in e[:, 2:]]])
+    if len(grazing):
+        wi = np.concatenate([wi, [_grazing(a, 10.0 ** e) for a, _, e in grazing]])
+        wo = np.concatenate([wo, [_grazing(b, 10.0 ** e) for _, b, e in grazing]])
+    return np.concatenate([wi, SPECIAL_WI]), np.concatenate([wo, SPECIAL_WO])
+
+
 # ---------------------------------------------------------------------------
 # The contract on one batch
 # ---------------------------------------------------------------------------
@@ -309,17 +324,7 @@ def test_random_parameters_and_directions(name):
         grazing=st.lists(st.tuples(st.floats(0, 360), st.floats(0, 360), st.floats(-40.0, -1.0)), max_size=4))
     def run(params, seed, extra, grazing):
         m = _model_or_reject(name, params)
-        wi, wo = random_pairs(seed, 64)
-        if extra:
-            e = np.array(extra)
-            wi = np.concatenate([wi, [_sph(a, b) for a, b in e[:, :2]]])
-            wo = np.concatenate([wo, [_sph(a, b) for a, b in e[:, 2:]]])
-        if grazing:  # both directions at one tiny elevation 10^e, any azimuths (issue 31)
-            wi = np.concatenate([wi, [_grazing(a, 10.0 ** e) for a, _, e in grazing]])
-            wo = np.concatenate([wo, [_grazing(b, 10.0 ** e) for _, b, e in grazing]])
-        wi = np.concatenate([wi, SPECIAL_WI])
-        wo = np.concatenate([wo, SPECIAL_WO])
-        check_both_dtypes(m, wi, wo)
+        check_both_dtypes(m, *drawn_pairs(seed, extra, grazing))
 
     run()
 

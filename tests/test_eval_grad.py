@@ -40,6 +40,7 @@ import pytest
 import brdfkit as bk
 from brdfkit import engine
 from brdfkit.geometry import random_unit_vectors
+from test_contract import _grazing
 
 #: relative tolerance of eval_grad against the extrapolated differences (float64)
 RTOL = 1e-6
@@ -499,9 +500,8 @@ def test_subnormal_elevations_give_no_nan_derivative(dtype, zs, distribution, sh
     wi, wo = [], []
     for zi, zo in itertools.product(zs + [0.5], zs + [0.5]):  # 0.5: pairs of one grazing, one not
         for az in (0.0, 10.0, 90.0, 170.0, 180.0):
-            for z, phi, out in ((zi, 0.0, wi), (zo, az, wo)):
-                r = math.sqrt(1.0 - z * z)
-                out.append((r * math.cos(math.radians(phi)), r * math.sin(math.radians(phi)), z))
+            wi.append(_grazing(0.0, zi))
+            wo.append(_grazing(az, zo))
     wi, wo = np.array(wi, dtype=dtype), np.array(wo, dtype=dtype)
     assert (wi[:, 2] > 0).all() and (wo[:, 2] > 0).all()  # none rounded to the horizon
     f, g = m.eval_grad(wi, wo)

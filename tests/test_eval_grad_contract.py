@@ -24,7 +24,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 import brdfkit as bk
-from test_contract import SETTINGS, SPECIAL_WI, SPECIAL_WO, _grazing, _moderate, _model_or_reject, params_strategy, random_pairs
+from test_contract import SETTINGS, _moderate, _model_or_reject, drawn_pairs, params_strategy
 from test_eval_grad import ANALYTIC, REFERENCE_ONLY, _covering
 
 MODELS = [n for n in ANALYTIC if n not in REFERENCE_ONLY]
@@ -71,12 +71,7 @@ def test_gradient_random_parameters_and_directions(name):
         if "multiscatter" in params:
             params["multiscatter"] = False  # no gradient with it (test_eval_grad)
         m = _model_or_reject(name, params)
-        wi, wo = random_pairs(seed, 64)
-        if grazing:  # both directions at one tiny elevation 10^e, any azimuths
-            wi = np.concatenate([wi, [_grazing(a, 10.0 ** e) for a, _, e in grazing]])
-            wo = np.concatenate([wo, [_grazing(b, 10.0 ** e) for _, b, e in grazing]])
-        wi = np.concatenate([wi, SPECIAL_WI])
-        wo = np.concatenate([wo, SPECIAL_WO])
+        wi, wo = drawn_pairs(seed, grazing=grazing)
         _check(m, wi, wo, np.float64)
         _check(m, wi, wo, np.float32)
 

@@ -68,15 +68,14 @@ def _expr(src: str) -> ast.expr:
 
 
 _MATH_UNARY = {
-    # name: derivative as a source template in x (the argument) and r (the result). Where the derivative is
-    # infinite (acos at ±1, log at 0) the rule gives the IEEE infinity instead of dividing by zero, which
-    # raises in Python (the reference engine) and gives inf in numba: both engines then compute the same
-    # tangent; a zero tangent that meets it stays 0 (_QUOTIENT_RULES, _UNBOUNDED_RULES), and an infinite
-    # tangent that only feeds floor/int/a comparison is dropped, as in htsg_series.thinning_step.
+    # name: derivative as a source template in x (the argument) and r (the result), which the tangent
+    # multiplies (log and log1p: _QUOTIENT_RULES). Where the derivative is infinite (acos at ±1) the rule
+    # gives the IEEE infinity instead of dividing by zero, which raises in Python (the reference engine)
+    # and gives inf in numba: both engines then compute the same tangent; a zero tangent that meets it
+    # stays 0 (_UNBOUNDED_RULES), and an infinite tangent that only feeds floor/int/a comparison is
+    # dropped, as in htsg_series.thinning_step.
     "sqrt": "(0.5 / r if r > 0.0 else 0.0)",
     "exp": "r",
-    "log": "(1.0 / x if x != 0.0 else math.inf)",
-    "log1p": "(1.0 / (1.0 + x) if x != -1.0 else math.inf)",
     "expm1": "(r + 1.0)",
     "sin": "math.cos(x)",
     "cos": "(-math.sin(x))",
@@ -94,12 +93,13 @@ _MATH_UNARY = {
     "ceil": None,
     "trunc": None,
 }
-#: the rules above that are 1/(an expression in x): the twin divides the tangent by it instead of
-#: multiplying by its reciprocal, which overflows first (ln d of a subnormal d: 1/d = inf where
-#: ∂d/d is ~1e300, Lafortune's lobe d^n = exp(n ln d) with C_z = 1e-300 at a grazing pair), and a zero
-#: tangent stays 0 (Lafortune's ∂/∂C_y where u_y v_y = 0 at a subnormal d: not 0 · inf)
+#: name: the source template in x of the expression whose reciprocal is the derivative. The twin divides the
+#: tangent by it instead of multiplying by its reciprocal, which overflows first (ln d of a subnormal d:
+#: 1/d = inf where ∂d/d is ~1e300, Lafortune's lobe d^n = exp(n ln d) with C_z = 1e-300 at a grazing
+#: pair); where it is 0 the derivative is ±inf, and a zero tangent stays 0 (Lafortune's ∂/∂C_y where
+#: u_y v_y = 0 at a subnormal d: not 0 · inf)
 _QUOTIENT_RULES = {"log": "x", "log1p": "(1.0 + x)"}
-#: the other rules above that are infinite somewhere or overflow near it (0.5/√x of a subnormal x, asin
+#: the rules of _MATH_UNARY that are infinite somewhere or overflow near it (0.5/√x of a subnormal x, asin
 #: and acos at ±1): their twin multiplies only a nonzero tangent by them, a zero one stays 0
 _UNBOUNDED_RULES = frozenset({"sqrt", "asin", "acos"})
 
@@ -618,25 +618,24 @@ class _Func:
         if fname == "abs" and len(vals) == 1:
             fname, func = "fabs", "abs"
         lines.append(f"{t} = {func}({', '.join(vals)})")
-        if fname in _MATH_UNARY and len(vals) == 1:
-            rule = _MATH_UNARY[fname]
+        if (fname in _MATH_UNARY or fname in _QUOTIENT_RULES) and len(vals) == 1:
             x = vals[0]
-            if fname in _QUOTIENT_RULES:  # dx / x: one rounding, and finite where 1/x alone overflows
+            if fname in _QUOTIENT_RULES:
                 den = _subst(_QUOTIENT_RULES[fname], x, t)
-                for j in keys:
-                    dx = ders[0][j]
-                    lines.append(f"{t}__d{j} = (({dx} / {den} if {den} != 0.0 else math.copysign(math.inf, {dx}))"
-                                 f" if {dx} != 0.0 else 0.0)")
-                    d_out[j] = f"{t}__d{j}"
-                return lines, t, d_out
-            g = self.tmp()
-            lines.append(f"{g} = {_subst(rule, x, t)}")
+            else:
+                g = self.tmp()
+                lines.append(f"{g} = {_subst(_MATH_UNARY[fname], x, t)}")
             for j in keys:
                 dx = ders[0][j]
-                # a rule that can be infinite (or overflow: 1/x of a subnormal x) meets a zero tangent as 0,
-                # the derivative along a direction that does not move x, not as inf · 0 = nan
-                lines.append(f"{t}__d{j} = ({g} * {dx} if {dx} != 0.0 else 0.0)" if fname in _UNBOUNDED_RULES else
-                             f"{t}__d{j} = {g} * {dx}")
+                # a derivative that can be infinite meets a zero tangent as 0 (the derivative along a
+                # direction that does not move x), not as inf · 0 = nan
+                if fname in _QUOTIENT_RULES:
+                    d = f"(({dx} / {den} if {den} != 0.0 else math.copysign(math.inf, {dx})) if {dx} != 0.0 else 0.0)"
+                elif fname in _UNBOUNDED_RULES:
+                    d = f"({g} * {dx} if {dx} != 0.0 else 0.0)"
+                else:
+                    d = f"{g} * {dx}"
+                lines.append(f"{t}__d{j} = {d}")
                 d_out[j] = f"{t}__d{j}"
             return lines, t, d_out
         if fname in ("pow", "atan2", "hypot", "copysign") and len(vals) == 2:

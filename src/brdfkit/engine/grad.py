@@ -346,8 +346,7 @@ def eval_grad(model, wi, wo, wrt=None):
             raise ValueError(f"{name}: no gradient ({e})") from None
     # microfacet's alpha sets both axes: its derivative, the sum of theirs, is a column of its own, summed
     # in the working precision (:func:`_stores`)
-    where = {k: off for k, off, _ in full}
-    alpha_sum = (n, (where["alpha_x"], where["alpha_y"])) if "alpha" in names else ()
+    alpha_sum = (n, tuple(off for k, off, _ in full if k in ("alpha_x", "alpha_y"))) if "alpha" in names else ()
     out = np.zeros((npairs, 3), dtype=dtype)
     gout = np.zeros((npairs, 3, n + bool(alpha_sum)), dtype=dtype)
     lim = float(np.finfo(dtype).max)
@@ -359,13 +358,13 @@ def eval_grad(model, wi, wo, wrt=None):
             with _LOCK:
                 drive = _grad_driver(kernel, choices, f32, seeds, alpha_sum)
             pt = _driver.param_tuple(p, ft)
-            w_i, w_o = _driver.read_only(fi), _driver.read_only(fo)
+            # float32 arrays through the float64 kernel: converted (read-only, as every driver input: one
+            # specialisation), computed in float64, rounded once as the driver stores into them (f at most
+            # float32's largest value, a derivative beyond its range ±inf)
+            w_i, w_o = (_driver.read_only(w.astype(ft, copy=False)) for w in (fi, fo))
             bad = np.zeros(_driver.nchunks(npairs), dtype=np.int64)
-            # float32 arrays through the float64 kernel: computed in float64, rounded once as the driver
-            # stores into them (f at most float32's largest value, a derivative beyond its range ±inf)
             lo2, hi2 = _driver.unit_band(out.dtype, ft)
-            _run(drive, w_i.astype(ft, copy=False), w_o.astype(ft, copy=False), pt, out, gout, ft(lim), lo2, hi2,
-                 bad, npairs)
+            _run(drive, w_i, w_o, pt, out, gout, ft(lim), lo2, hi2, bad, npairs)
             if bad.any():  # some length outside the safe band: the exact check (raises where one is not unit)
                 check_unit_flat(name, fi, fo, dtype)
         else:
@@ -373,8 +372,8 @@ def eval_grad(model, wi, wo, wrt=None):
             o64 = np.zeros((npairs, 3))
             g64 = np.zeros((npairs, 3, gout.shape[2]))
             _reference(kernel, seeds, fi, fo, p, c, o64, g64[..., :n], lim)
-            if alpha_sum:
-                g64[..., n] = g64[..., seeds.index(where["alpha_x"])] + g64[..., seeds.index(where["alpha_y"])]
+            if alpha_sum:  # the columns of alpha_x and alpha_y, as the compiled driver adds them
+                g64[..., n] = sum(g64[..., seeds.index(k)] for k in alpha_sum[1])
             out[...] = o64
             with np.errstate(over="ignore"):  # a derivative beyond float32's range is ±inf
                 gout[...] = g64

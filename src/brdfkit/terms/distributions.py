@@ -157,9 +157,10 @@ def lambda_floor(wz):
     """``w_z`` for Smith's Λ: a subnormal ``w_z`` (below 2.2e-308; 1.2e-38 in a float32 twin) raised to the
     smallest normal number. Λ ~ α(w)/(2 w_z) (GGX; Beckmann's is √π smaller) grows without bound as
     w_z → 0, and so does its derivative with respect to α: from a subnormal w_z both overflowed, and
-    ``G = 1/(1 + Λi + Λo)``'s derivative came out as inf·0 = NaN (issue 31's gradients). With the floor Λ and its derivative stay below
-    2.3e307 (float32: 4.3e37) for α ≤ 1, twice that summed; the value changes only where G1 ≈ 1/Λ is
-    already at the bottom of the float range. ``w_z <= 0`` passes through (Λ = +inf there)."""
+    ``G = 1/(1 + Λi + Λo)``'s derivative came out as inf·0 = NaN (issue 31's gradients). With the floor
+    Λ and its derivative stay below 2.3e307 (float32: 4.3e37) for α ≤ 1, twice that summed; the value
+    changes only where G1 ≈ 1/Λ is already at the bottom of the float range. ``w_z <= 0`` passes through
+    (Λ = +inf there)."""
     return max(wz, NORMAL_MIN) if wz > 0.0 else wz
 
 
